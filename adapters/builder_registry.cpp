@@ -1,0 +1,89 @@
+#include "builder_registry.h"
+
+#include <fmt/format.h>
+
+#include <stdexcept>
+
+#include "embree/embree_builder.h"
+#include "embree/embree_device.h"
+
+namespace kmbvh {
+namespace {
+
+bool is_embree(const std::string& name, EmbreeQuality* quality) {
+  if (name == "embree-low") *quality = EmbreeQuality::Low;
+  else if (name == "embree-medium") *quality = EmbreeQuality::Medium;
+  else if (name == "embree-high") *quality = EmbreeQuality::High;
+  else return false;
+  return true;
+}
+
+}  // namespace
+
+std::string BuilderConfig::label() const {
+  if (builder != "kmeans") return builder;
+  const std::string medians = kmeans.metric == ClusterMetric::Medians ? " medians" : "";
+  const std::string wide = kmeans.wide ? " wide" : "";
+  if (!preset.empty()) return fmt::format("kmeans {}{}{}", preset, medians, wide);
+  return fmt::format("kmeans k={} p={} i={}{}{}", kmeans.k, kmeans.p, kmeans.i, medians, wide);
+}
+
+const std::vector<std::string>& builder_names() {
+  static const std::vector<std::string> names{"kmeans", "embree-low", "embree-medium", "embree-high"};
+  return names;
+}
+
+BuilderConfig parse_builder(const std::string& spec) {
+  BuilderConfig config;
+  std::string name = spec, preset = "Q2";
+  if (const auto colon = spec.find(':'); colon != std::string::npos) {
+    name = spec.substr(0, colon);
+    preset = spec.substr(colon + 1);
+  } else if (kmeans_preset(spec)) {
+    name = "kmeans";
+    preset = spec;
+  }
+  config.builder = name;
+  EmbreeQuality quality;
+  if (name == "kmeans") {
+    const auto params = kmeans_preset(preset);
+    if (!params) throw std::invalid_argument(fmt::format("unknown k-means preset '{}' (Q1 to Q5)", preset));
+    config.kmeans = *params;
+    config.preset = preset;
+    for (char& c : config.preset) c = char(std::toupper(static_cast<unsigned char>(c)));
+  } else if (!is_embree(name, &quality)) {
+    throw std::invalid_argument(
+        fmt::format("unknown builder '{}' (kmeans, Q1..Q5, embree-low, embree-medium, embree-high)", spec));
+  }
+  return config;
+}
+
+void prepare_builder(const BuilderConfig& config) {
+  EmbreeQuality quality;
+  if (is_embree(config.builder, &quality)) shared_embree_device();
+}
+
+Bvh run_builder(const BuilderConfig& config, const PrimitiveSet& prims, BuildInfo* info) {
+  EmbreeQuality quality;
+  if (config.builder == "kmeans") {
+    KMeansParams params = config.kmeans;
+    params.max_leaf_size = config.max_leaf_size;
+    return build_kmeans(prims, params, config.backend, info);
+  }
+  if (is_embree(config.builder, &quality)) {
+    EmbreeBuildOptions options;
+    options.quality = quality;
+    options.max_leaf_size = config.max_leaf_size;
+    return build_embree(prims, options, info);
+  }
+  throw std::invalid_argument(fmt::format("unknown builder '{}'", config.builder));
+}
+
+ValidationLimits validation_limits(const BuilderConfig& config) {
+  ValidationLimits limits;
+  limits.max_leaf_size = config.max_leaf_size;
+  limits.max_arity = (config.builder == "kmeans" && config.kmeans.wide) ? config.kmeans.k : 2;
+  return limits;
+}
+
+}  // namespace kmbvh

@@ -1,0 +1,40 @@
+#include "triangle_scene.h"
+
+namespace kmbvh {
+
+Aabb TriangleScene::triangle_box(size_t t) const {
+  Aabb b;
+  for (uint32_t v : triangles[t]) b.grow(positions[v]);
+  return b;
+}
+
+Aabb TriangleScene::bounds() const {
+  Aabb b;
+  for (const Vec3& p : positions) b.grow(p);
+  return b;
+}
+
+void TriangleScene::add_triangle(Vec3 a, Vec3 b, Vec3 c) {
+  const auto base = static_cast<uint32_t>(positions.size());
+  positions.insert(positions.end(), {a, b, c});
+  triangles.push_back({base, base + 1, base + 2});
+}
+
+PrimitiveSet make_primitive_set(const TriangleScene& scene, size_t* dropped) {
+  PrimitiveSet set;
+  set.boxes.reserve(scene.size());
+  set.ids.reserve(scene.size());
+  size_t skipped = 0;
+  for (size_t t = 0; t < scene.size(); ++t) {
+    const Triangle& v = scene.triangles[t];
+    if (!is_finite(scene.positions[v[0]]) || !is_finite(scene.positions[v[1]]) || !is_finite(scene.positions[v[2]])) {
+      ++skipped;
+      continue;
+    }
+    set.push_back(scene.triangle_box(t), PrimitiveId{0, static_cast<uint32_t>(t)});
+  }
+  if (dropped) *dropped = skipped;
+  return set;
+}
+
+}  // namespace kmbvh

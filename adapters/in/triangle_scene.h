@@ -1,0 +1,40 @@
+// A scene as the loaders produce it: one flat triangle list (every mesh of the file, node
+// transforms applied), and what was skipped on the way.
+#pragma once
+
+#include <array>
+#include <cstdint>
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "cuda/core/aabb.h"
+#include "cuda/core/primitive_set.h"
+
+namespace kmbvh {
+
+using Triangle = std::array<uint32_t, 3>;
+
+struct TriangleScene {
+  std::string name;                   // the file's name, or "default"
+  std::vector<Vec3> positions;
+  std::vector<Triangle> triangles;    // indices into positions, all in range
+  std::vector<std::string> warnings;  // what was skipped, in words
+
+  size_t size() const { return triangles.size(); }
+  Aabb triangle_box(size_t t) const;
+  Aabb bounds() const;
+  void add_triangle(Vec3 a, Vec3 b, Vec3 c);
+};
+
+// A file that cannot be read: the message names the file and the problem, on one line.
+class SceneError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// One box per triangle; ids are the triangles' indices. Triangles with a non-finite
+// vertex are left out, as Embree's scene commit leaves them out; `dropped` counts them.
+PrimitiveSet make_primitive_set(const TriangleScene& scene, size_t* dropped = nullptr);
+
+}  // namespace kmbvh

@@ -1,0 +1,12 @@
+# Everything comes from Debian 12 packages (scripts/install-deps.sh installs them).
+find_package(OpenMP REQUIRED)
+find_package(embree 3 REQUIRED)
+find_package(TinyGLTF REQUIRED)
+find_package(tinyobjloader REQUIRED)
+find_package(CLI11 REQUIRED)
+find_package(nlohmann_json 3 REQUIRED)
+find_package(fmt REQUIRED)
+find_package(glm REQUIRED)
+if(KMBVH_TESTS)
+  find_package(GTest REQUIRED)
+endif()

@@ -1,0 +1,31 @@
+// What a builder may report besides its tree: where its time went, for the phase charts
+// and for finding what limits it.
+#pragma once
+
+#include <cstdint>
+#include <string>
+#include <utility>
+#include <vector>
+
+namespace kmbvh {
+
+struct BuildInfo {
+  std::vector<std::pair<std::string, double>> phase_ms;  // in the order the phases first ran
+  uint32_t levels = 0;          // top-down levels (k-means)
+  uint32_t forced_splits = 0;   // nodes split by position because clustering could not split them
+  // Time inside the builder call spent only to hand its result to kmbvh's measuring (for
+  // Embree: refilling its input array and converting its nodes into a Bvh). Reported build
+  // times leave it out, so each builder is charged what an application using it pays.
+  double excluded_ms = 0;
+
+  void add_phase(const std::string& name, double ms) {
+    for (auto& [n, t] : phase_ms)
+      if (n == name) {
+        t += ms;
+        return;
+      }
+    phase_ms.emplace_back(name, ms);
+  }
+};
+
+}  // namespace kmbvh

@@ -1,0 +1,36 @@
+// The k-means BVH builder (Meister and Bittner 2016), DESIGN.md §4: top-down k-means
+// clustering of primitive boxes, all nodes of a level together, then agglomerative
+// treelets that make each k-ary node binary (or, with KMeansParams::wide, the k-ary tree
+// itself). Runs on the CPU backend (Thrust over OpenMP) and, when built with nvcc, on the
+// GPU: the same kernel bodies either way.
+#pragma once
+
+#include "../core/build_info.h"
+#include "../core/bvh.h"
+#include "../core/primitive_set.h"
+#include "params.h"
+
+namespace kmbvh {
+
+enum class Backend { Cpu, Cuda };
+
+const char* to_string(Backend backend);
+bool cuda_backend_compiled();
+// True when the CUDA backend is compiled in and a CUDA device can be used.
+bool cuda_device_available();
+
+// Throws std::invalid_argument for parameters check_params() rejects, and
+// std::runtime_error when the backend cannot run (no CUDA device).
+// The boxes must be finite with lo <= hi (adapters drop the primitives that are not).
+Bvh build_kmeans(const PrimitiveSet& prims, const KMeansParams& params, Backend backend = Backend::Cpu,
+                 BuildInfo* info = nullptr);
+
+namespace detail {
+Bvh build_kmeans_cpu(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info);
+#if defined(KMBVH_HAS_CUDA)
+Bvh build_kmeans_gpu(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info);
+bool cuda_device_present();
+#endif
+}  // namespace detail
+
+}  // namespace kmbvh

@@ -1,0 +1,303 @@
+// The level loop of the k-means builder, written once against Thrust and compiled twice
+// (DESIGN.md §3): by g++ with Thrust's OpenMP device system (kmeans_builder_cpu.cpp) and
+// by nvcc for the GPU (kmeans_builder_gpu.cu). The including file defines
+// KMBVH_BACKEND_NAMESPACE (so the two instantiations never collide) and
+// KMBVH_PIECE_SIZE (primitives per work item of the per-primitive kernels).
+//
+// Per level (DESIGN.md §4): set up the segments' clusters and pieces, initialise the
+// representatives, run i Lloyd iterations (assign, update), assign once more, partition
+// each segment by cluster, and emit the children: leaves, treelet nodes and the next
+// level's segments.
+
+#include <thrust/copy.h>
+#include <thrust/count.h>
+#include <thrust/device_vector.h>
+#include <thrust/execution_policy.h>
+#include <thrust/fill.h>
+#include <thrust/for_each.h>
+#include <thrust/iterator/counting_iterator.h>
+#include <thrust/reduce.h>
+#include <thrust/scan.h>
+#include <thrust/sequence.h>
+#include <thrust/transform_scan.h>
+
+#include <chrono>
+#include <utility>
+
+#include "../core/breadth_first.h"
+#include "agglomerate.h"
+#include "assign.h"
+#include "emit.h"
+#include "kmeans_builder.h"
+#include "partition.h"
+#include "setup.h"
+#include "update_means.h"
+#include "update_medians.h"
+
+#if !defined(KMBVH_BACKEND_NAMESPACE) || !defined(KMBVH_PIECE_SIZE)
+#error "define KMBVH_BACKEND_NAMESPACE and KMBVH_PIECE_SIZE before including kmeans_builder.inl"
+#endif
+
+namespace kmbvh {
+namespace KMBVH_BACKEND_NAMESPACE {
+
+template <typename T>
+using Buffer = thrust::device_vector<T>;
+
+template <typename T>
+T* ptr(Buffer<T>& b) {
+  return thrust::raw_pointer_cast(b.data());
+}
+
+template <typename T>
+void grow_to(Buffer<T>& b, size_t n) {
+  if (b.size() < n) b.resize(n);
+}
+
+template <typename F>
+void for_each_index(uint32_t n, const F& f) {
+  if (n > 0) thrust::for_each_n(thrust::device, thrust::counting_iterator<uint32_t>(0), n, f);
+}
+
+struct JoinBoxes {
+  KMBVH_HD Aabb operator()(const Aabb& a, const Aabb& b) const { return join(a, b); }
+};
+
+struct IsSplitByIndex {
+  KMBVH_HD bool operator()(const Segment& s) const { return s.split_by_index != 0; }
+};
+
+// Times phases on the host; every Thrust algorithm used here blocks until it is done.
+class PhaseClock {
+ public:
+  explicit PhaseClock(BuildInfo* info) : info_(info), last_(std::chrono::steady_clock::now()) {}
+  void lap(const char* phase) {
+    const auto now = std::chrono::steady_clock::now();
+    if (info_) info_->add_phase(phase, std::chrono::duration<double, std::milli>(now - last_).count());
+    last_ = now;
+  }
+
+ private:
+  BuildInfo* info_;
+  std::chrono::steady_clock::time_point last_;
+};
+
+template <uint32_t KMax, ClusterMetric M>
+class KMeansLevels {
+ public:
+  KMeansLevels(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info)
+      : params_(params), n_(static_cast<uint32_t>(prims.size())), info_(info), clock_(info) {
+    boxes_[0] = Buffer<Aabb>(prims.boxes.begin(), prims.boxes.end());
+    boxes_[1].resize(n_);
+    ids_[0].resize(n_);
+    thrust::sequence(thrust::device, ids_[0].begin(), ids_[0].end());
+    ids_[1].resize(n_);
+    final_ids_.resize(n_);
+    cluster_of_.resize(n_);
+    nodes_.reserve(n_ / 2 + 16);
+  }
+
+  Bvh run() {
+    const Aabb root_box = thrust::reduce(thrust::device, boxes_[0].begin(), boxes_[0].end(),
+                                         Aabb::empty(), JoinBoxes{});
+    nodes_.resize(1);
+    nodes_[0] = BvhNode::make_interior(root_box, 0, 0);
+    node_count_ = 1;
+    Segment root;
+    root.count = n_;
+    root.k = rules().child_k(n_);
+    root.box = root_box;
+    segments_.resize(1);
+    segments_[0] = root;
+    uint32_t segment_count = 1;
+    clock_.lap("setup");
+
+    while (segment_count > 0) {
+      if (info_) ++info_->levels;
+      segment_count = split_level(segment_count);
+      current_ = 1 - current_;
+    }
+    return finish();
+  }
+
+ private:
+  EmitRules rules() const { return {params_.max_leaf_size, params_.k, params_.wide}; }
+
+  LevelView view() {
+    return {ptr(boxes_[current_]), ptr(ids_[current_]), ptr(cluster_of_), ptr(segments_),
+            ptr(pieces_), ptr(piece_counters_), clusters()};
+  }
+  ClusterArrays clusters() {
+    return {ptr(reps_), ptr(sums_), ptr(counts_), ptr(bounds_), ptr(cluster_begin_), ptr(cluster_segment_)};
+  }
+
+  // Splits every segment of the level; returns the number of segments of the next one.
+  uint32_t split_level(uint32_t segment_count) {
+    const uint32_t clusters = set_up(segment_count);
+    for_each_index(segment_count, InitialiseSegment<M>{ptr(boxes_[current_]), ptr(segments_), ptr(reps_),
+                                                       params_.p, params_.seed});
+    clock_.lap("initialise");
+
+    for (uint32_t iteration = 0; iteration < params_.i; ++iteration) {
+      if constexpr (M == ClusterMetric::Means) {
+        clear_clusters(clusters, true);
+        for_each_index(piece_count_, AssignPiece<KMax, M, AssignPass::Sums>{view()});
+        clock_.lap("assign");
+        for_each_index(clusters, UpdateMeans{ptr(segments_), this->clusters()});
+        clock_.lap("update");
+      } else {
+        clear_clusters(clusters, false);
+        for_each_index(piece_count_, AssignPiece<KMax, M, AssignPass::Final>{view()});
+        clock_.lap("assign");
+        partition(segment_count, /*gather_only=*/true);
+        for_each_index(clusters, UpdateMedians{ptr(boxes_[1 - current_]), this->clusters()});
+        clock_.lap("update");
+      }
+    }
+
+    clear_clusters(clusters, false);
+    for_each_index(piece_count_, AssignPiece<KMax, M, AssignPass::Final>{view()});
+    clock_.lap("assign");
+    for_each_index(segment_count, DetectSingleCluster{ptr(segments_), this->clusters()});
+    const auto forced = thrust::count_if(thrust::device, segments_.begin(),
+                                         segments_.begin() + segment_count, IsSplitByIndex{});
+    if (forced > 0) {
+      for_each_index(piece_count_, AssignPiece<KMax, M, AssignPass::SplitByIndex>{view()});
+      if (info_) info_->forced_splits += static_cast<uint32_t>(forced);
+    }
+    partition(segment_count, /*gather_only=*/false);
+    return emit(segment_count);
+  }
+
+  // Offsets of every segment's clusters, pieces and counters; returns the cluster count.
+  uint32_t set_up(uint32_t segment_count) {
+    const SizesOfSegment sizes{KMBVH_PIECE_SIZE};
+    grow_to(segment_offsets_, segment_count);
+    thrust::transform_exclusive_scan(thrust::device, segments_.begin(), segments_.begin() + segment_count,
+                                     segment_offsets_.begin(), sizes, SegmentSizes{}, AddSegmentSizes{});
+    const SegmentSizes total =
+        AddSegmentSizes{}(segment_offsets_[segment_count - 1], sizes(segments_[segment_count - 1]));
+    piece_count_ = total.pieces;
+    grow_to(pieces_, total.pieces);
+    grow_to(piece_counters_, total.counters);
+    grow_to(reps_, total.clusters);
+    grow_to(sums_, total.clusters);
+    grow_to(counts_, total.clusters);
+    grow_to(bounds_, total.clusters);
+    grow_to(cluster_begin_, total.clusters);
+    grow_to(cluster_segment_, total.clusters);
+    for_each_index(segment_count, SetupSegment{ptr(segments_), ptr(segment_offsets_), sizes, ptr(pieces_),
+                                               ptr(cluster_segment_)});
+    clock_.lap("setup");
+    return total.clusters;
+  }
+
+  void clear_clusters(uint32_t clusters, bool sums) {
+    thrust::fill_n(thrust::device, counts_.begin(), clusters, 0u);
+    if (sums)
+      thrust::fill_n(thrust::device, sums_.begin(), clusters, ClusterSums{});
+    else
+      thrust::fill_n(thrust::device, bounds_.begin(), clusters, OrderedBounds::empty());
+  }
+
+  // Counting sort of every segment by cluster into the other buffer. A median update
+  // only gathers the boxes; the level's last partition moves ids and output order too.
+  void partition(uint32_t segment_count, bool gather_only) {
+    for_each_index(segment_count, PlaceClusters{ptr(segments_), ptr(pieces_), ptr(piece_counters_), clusters()});
+    const int to = 1 - current_;
+    for_each_index(piece_count_,
+                   ScatterPiece<KMax>{ptr(boxes_[current_]), ptr(ids_[current_]), ptr(cluster_of_),
+                                      ptr(segments_), ptr(pieces_), ptr(piece_counters_), ptr(boxes_[to]),
+                                      gather_only ? nullptr : ptr(ids_[to]),
+                                      gather_only ? nullptr : ptr(final_ids_)});
+    clock_.lap("partition");
+  }
+
+  uint32_t emit(uint32_t segment_count) {
+    grow_to(child_counts_, segment_count);
+    grow_to(child_offsets_, segment_count);
+    for_each_index(segment_count, CountChildren{ptr(segments_), clusters(), rules(), ptr(child_counts_)});
+    thrust::exclusive_scan(thrust::device, child_counts_.begin(), child_counts_.begin() + segment_count,
+                           child_offsets_.begin(), ChildCounts{}, AddChildCounts{});
+    const ChildCounts total =
+        AddChildCounts{}(child_offsets_[segment_count - 1], child_counts_[segment_count - 1]);
+    nodes_.resize(node_count_ + total.nodes);
+    grow_to(next_segments_, total.segments);
+    for_each_index(segment_count, EmitChildren<KMax>{ptr(segments_), clusters(), rules(), ptr(child_offsets_),
+                                                     node_count_, ptr(nodes_), ptr(next_segments_)});
+    node_count_ += total.nodes;
+    std::swap(segments_, next_segments_);
+    clock_.lap("agglomerate");
+    return total.segments;
+  }
+
+  // Copies the tree out, freeing each working buffer as soon as it is done with, so that
+  // the finishing step does not raise the build's peak memory.
+  Bvh finish() {
+    release(boxes_[0], boxes_[1], ids_[0], ids_[1], cluster_of_, segments_, next_segments_, segment_offsets_,
+            pieces_, piece_counters_, reps_, sums_, counts_, bounds_, cluster_begin_, cluster_segment_,
+            child_counts_, child_offsets_);
+    Bvh raw;
+    raw.nodes.resize(node_count_);
+    thrust::copy(nodes_.begin(), nodes_.begin() + node_count_, raw.nodes.begin());
+    release(nodes_);
+    raw.prim_indices.resize(n_);
+    thrust::copy(final_ids_.begin(), final_ids_.end(), raw.prim_indices.begin());
+    release(final_ids_);
+    Bvh bvh = reorder_breadth_first(std::move(raw));
+    clock_.lap("finish");
+    return bvh;
+  }
+
+  template <typename... Buffers>
+  static void release(Buffers&... buffers) {
+    (..., (buffers.clear(), buffers.shrink_to_fit()));
+  }
+
+  const KMeansParams params_;
+  const uint32_t n_;
+  BuildInfo* info_;
+  PhaseClock clock_;
+
+  int current_ = 0;  // which of the double buffers holds the level's primitives
+  Buffer<Aabb> boxes_[2];
+  Buffer<uint32_t> ids_[2];
+  Buffer<uint32_t> final_ids_;
+  Buffer<uint8_t> cluster_of_;
+
+  Buffer<Segment> segments_, next_segments_;
+  Buffer<SegmentSizes> segment_offsets_;
+  Buffer<Piece> pieces_;
+  uint32_t piece_count_ = 0;
+  Buffer<uint32_t> piece_counters_;
+
+  Buffer<Aabb> reps_;
+  Buffer<ClusterSums> sums_;
+  Buffer<uint32_t> counts_;
+  Buffer<OrderedBounds> bounds_;
+  Buffer<uint32_t> cluster_begin_;
+  Buffer<uint32_t> cluster_segment_;
+
+  Buffer<ChildCounts> child_counts_, child_offsets_;
+  Buffer<BvhNode> nodes_;
+  uint32_t node_count_ = 0;
+};
+
+template <ClusterMetric M>
+Bvh build_with_metric(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info) {
+  // Local arrays in the kernels are sized by the smallest bound that holds k.
+  if (params.k <= 8) return KMeansLevels<8, M>(prims, params, info).run();
+  if (params.k <= 16) return KMeansLevels<16, M>(prims, params, info).run();
+  if (params.k <= 32) return KMeansLevels<32, M>(prims, params, info).run();
+  return KMeansLevels<64, M>(prims, params, info).run();
+}
+
+inline Bvh build(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info) {
+  const uint32_t n = static_cast<uint32_t>(prims.size());
+  if (n <= params.max_leaf_size) return Bvh::single_leaf(prims.bounds(), n);
+  if (params.metric == ClusterMetric::Means) return build_with_metric<ClusterMetric::Means>(prims, params, info);
+  return build_with_metric<ClusterMetric::Medians>(prims, params, info);
+}
+
+}  // namespace KMBVH_BACKEND_NAMESPACE
+}  // namespace kmbvh

@@ -1,0 +1,13 @@
+// The CPU instantiation of the k-means level loop: g++ with Thrust's OpenMP device system.
+// Pieces are large so that each OpenMP work item amortises its per-cluster publishing.
+#define KMBVH_BACKEND_NAMESPACE cpu_backend
+#define KMBVH_PIECE_SIZE 2048u
+#include "kmeans_builder.inl"
+
+namespace kmbvh::detail {
+
+Bvh build_kmeans_cpu(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info) {
+  return cpu_backend::build(prims, params, info);
+}
+
+}  // namespace kmbvh::detail

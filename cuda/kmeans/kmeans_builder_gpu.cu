@@ -1,0 +1,24 @@
+// The GPU instantiation of the k-means level loop: nvcc, Thrust's CUDA system. Pieces are
+// small so that a level has many work items even near the root.
+#define KMBVH_BACKEND_NAMESPACE gpu_backend
+#define KMBVH_PIECE_SIZE 64u
+#include "kmeans_builder.inl"
+
+#include <cuda_runtime.h>
+
+namespace kmbvh::detail {
+
+Bvh build_kmeans_gpu(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info) {
+  return gpu_backend::build(prims, params, info);
+}
+
+bool cuda_device_present() {
+  int devices = 0;
+  if (cudaGetDeviceCount(&devices) != cudaSuccess) {
+    cudaGetLastError();  // clear the sticky "no device" error
+    return false;
+  }
+  return devices > 0;
+}
+
+}  // namespace kmbvh::detail

@@ -1,0 +1,62 @@
+#include "params.h"
+
+#include <fmt/format.h>
+
+#include <cctype>
+
+namespace kmbvh {
+namespace {
+
+struct Preset {
+  const char* name;
+  uint32_t k, p, i;
+};
+// Meister and Bittner 2016, Table 1.
+constexpr Preset kPresets[] = {
+    {"Q1", 8, 5, 0}, {"Q2", 8, 5, 2}, {"Q3", 16, 5, 5}, {"Q4", 32, 20, 10}, {"Q5", 64, 30, 15},
+};
+constexpr const char* kNames[] = {"Q1", "Q2", "Q3", "Q4", "Q5", nullptr};
+
+std::string upper(std::string s) {
+  for (char& c : s) c = char(std::toupper(static_cast<unsigned char>(c)));
+  return s;
+}
+
+}  // namespace
+
+std::optional<KMeansParams> kmeans_preset(const std::string& name) {
+  const std::string wanted = upper(name);
+  for (const Preset& preset : kPresets) {
+    if (wanted != preset.name) continue;
+    KMeansParams params;
+    params.k = preset.k;
+    params.p = preset.p;
+    params.i = preset.i;
+    return params;
+  }
+  return std::nullopt;
+}
+
+const char* const* kmeans_preset_names() { return kNames; }
+
+std::string to_string(ClusterMetric metric) {
+  return metric == ClusterMetric::Means ? "means" : "medians";
+}
+
+std::optional<ClusterMetric> parse_metric(const std::string& name) {
+  if (name == "means" || name == "mean") return ClusterMetric::Means;
+  if (name == "medians" || name == "median") return ClusterMetric::Medians;
+  return std::nullopt;
+}
+
+std::string check_params(const KMeansParams& params) {
+  if (params.k < 2 || params.k > KMeansParams::kMaxK)
+    return fmt::format("k must be in [2, {}], got {}", KMeansParams::kMaxK, params.k);
+  if (params.p < 1) return "p (candidates per representative) must be at least 1";
+  if (params.max_leaf_size < 1 || params.max_leaf_size > 255)
+    return fmt::format("the max leaf size m must be in [1, 255], got {}", params.max_leaf_size);
+  if (params.i > 1000) return fmt::format("i (Lloyd iterations) must be at most 1000, got {}", params.i);
+  return {};
+}
+
+}  // namespace kmbvh

@@ -1,0 +1,54 @@
+// The kmbvh command line's subcommands.
+#pragma once
+
+#include <CLI/CLI.hpp>
+#include <string>
+#include <vector>
+
+namespace kmbvh {
+
+// Exit codes: 0 done; 1 a build failed; 2 bad input (unreadable file, bad argument);
+// 3 a tree failed validation.
+enum ExitCode { kExitOk = 0, kExitBuildFailed = 1, kExitBadInput = 2, kExitInvalidTree = 3 };
+
+struct RunOptions {
+  int threads = 0;  // 0: every hardware thread
+  int runs = 5;
+  int warmup = 1;
+  bool quiet = false;
+  bool json = false;
+  std::string backend = "cpu";
+};
+
+struct BuilderOptions {
+  std::string builder = "kmeans";
+  std::string preset = "Q2";
+  uint32_t k = 0, p = 0, i = 0;
+  CLI::Option *k_opt = nullptr, *p_opt = nullptr, *i_opt = nullptr;
+  uint32_t max_leaf_size = 8;
+  uint32_t seed = 1;
+  std::string metric = "means";
+  bool wide = false;
+};
+
+struct BuildCommand {
+  std::string scene;
+  BuilderOptions builder;
+  RunOptions run;
+};
+
+struct BenchCommand {
+  std::vector<std::string> scenes{"sponza_dabrovic", "sibenik", "conference"};
+  std::string builders = "Q1,Q2,Q3,Q4,Q5,embree-medium";
+  std::string reference = "embree-medium";
+  std::string csv_path;
+  RunOptions run;
+};
+
+void add_build_command(CLI::App& app, BuildCommand& command);
+void add_bench_command(CLI::App& app, BenchCommand& command);
+
+int run_build(const BuildCommand& command);
+int run_bench(const BenchCommand& command);
+
+}  // namespace kmbvh

@@ -1,0 +1,45 @@
+// kmbvh: build BVHs by k-means clustering (Meister and Bittner 2016) and compare them with
+// Embree's. `kmbvh build` runs one builder on one scene; `kmbvh bench` compares several.
+#include <fmt/format.h>
+
+#include <malloc.h>
+
+#include <CLI/CLI.hpp>
+#include <stdexcept>
+
+#include "adapters/in/triangle_scene.h"
+#include "commands.h"
+
+int main(int argc, char** argv) {
+  using namespace kmbvh;
+  // Large blocks always come from mmap and go back to the system when freed. glibc would
+  // otherwise raise this threshold after the first large free and keep later builds'
+  // memory on its heap, and each build's memory could not be measured apart.
+  mallopt(M_MMAP_THRESHOLD, 256 * 1024);
+  CLI::App app{"kmbvh: k-means BVH construction, measured against Embree"};
+  app.require_subcommand(1);
+  BuildCommand build;
+  BenchCommand bench;
+  add_build_command(app, build);
+  add_bench_command(app, bench);
+  try {
+    app.parse(argc, argv);
+  } catch (const CLI::ParseError& e) {
+    const int code = app.exit(e);
+    return code == 0 ? kExitOk : kExitBadInput;
+  }
+
+  try {
+    if (app.got_subcommand("build")) return run_build(build);
+    return run_bench(bench);
+  } catch (const SceneError& e) {
+    fmt::print(stderr, "kmbvh: error: {}\n", e.what());
+    return kExitBadInput;
+  } catch (const std::invalid_argument& e) {
+    fmt::print(stderr, "kmbvh: error: {}\n", e.what());
+    return kExitBadInput;
+  } catch (const std::exception& e) {
+    fmt::print(stderr, "kmbvh: build failed: {}\n", e.what());
+    return kExitBuildFailed;
+  }
+}

@@ -1,0 +1,85 @@
+#include "measure.h"
+
+#include <fmt/format.h>
+
+#include <algorithm>
+#include <chrono>
+
+#include "adapters/in/default_scene.h"
+#include "adapters/in/load_scene.h"
+#include "adapters/in/scene_folder.h"
+#include "cuda/core/threads.h"
+#include "cuda/metrics/sah.h"
+#include "memory.h"
+
+namespace kmbvh {
+
+double median(std::vector<double> v) {
+  if (v.empty()) return 0.0;
+  std::sort(v.begin(), v.end());
+  const size_t h = v.size() / 2;
+  return v.size() % 2 ? v[h] : 0.5 * (v[h - 1] + v[h]);
+}
+
+LoadedScene load_scene_argument(const std::string& argument) {
+  const auto start = std::chrono::steady_clock::now();
+  TriangleScene scene;
+  if (argument.empty() || argument == "default") {
+    scene = make_default_scene();
+  } else {
+    const auto path = find_scene_file(argument);
+    if (!path)
+      throw SceneError(fmt::format("{}: no such file (nor a scene of that name in {})", argument, scene_folder()));
+    scene = load_scene_file(*path);
+  }
+  LoadedScene loaded;
+  loaded.name = scene.name;
+  loaded.triangles = scene.size();
+  loaded.prims = make_primitive_set(scene, &loaded.dropped);
+  for (const std::string& w : scene.warnings) fmt::print(stderr, "kmbvh: warning: {}: {}\n", scene.name, w);
+  if (loaded.dropped)
+    fmt::print(stderr, "kmbvh: warning: {}: {} triangles with non-finite vertices left out\n", scene.name,
+               loaded.dropped);
+  loaded.load_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  return loaded;
+}
+
+Measurement measure(const LoadedScene& scene, const BuilderConfig& config, const MeasureOptions& options) {
+  Measurement m;
+  m.scene = scene.name;
+  m.triangles = scene.triangles;
+  m.config = config;
+  m.threads = thread_count();
+
+  prepare_builder(config);
+  const size_t rss_before = current_rss_bytes();
+  reset_peak_rss();
+  Bvh bvh;
+  const int total = options.warmup + options.runs;
+  for (int run = 0; run < total; ++run) {
+    if (options.progress)
+      options.progress(run < options.warmup ? fmt::format("{}: {} warm-up", scene.name, config.label())
+                                            : fmt::format("{}: {} run {}/{}", scene.name, config.label(),
+                                                          run - options.warmup + 1, options.runs));
+    bvh = Bvh();  // the previous tree's memory is not the next build's
+    BuildInfo info;
+    const auto start = std::chrono::steady_clock::now();
+    bvh = run_builder(config, scene.prims, &info);
+    const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+    if (run >= options.warmup) m.build_ms_runs.push_back(ms - info.excluded_ms);
+    m.info = info;
+  }
+  const size_t peak = peak_rss_bytes();
+  m.build_ms = median(m.build_ms_runs);
+  m.peak_rss_mb = peak / 1048576.0;
+  m.build_memory_mb = peak > rss_before ? (peak - rss_before) / 1048576.0 : 0.0;
+  m.build_bytes_per_triangle = scene.prims.empty() ? 0.0 : m.build_memory_mb * 1048576.0 / scene.prims.size();
+
+  if (options.progress) options.progress(fmt::format("{}: {} validating", scene.name, config.label()));
+  m.stats = tree_stats(bvh);
+  m.validation = validate(bvh, scene.prims, validation_limits(config));
+  m.sah_cost = m.validation.sah_reported;
+  return m;
+}
+
+}  // namespace kmbvh

@@ -1,0 +1,55 @@
+// Running one builder on one scene the way DESIGN.md §6 measures: warm-up, several timed
+// runs (median reported), memory of the build, then the full validation of the tree.
+#pragma once
+
+#include <cstddef>
+#include <functional>
+#include <string>
+#include <vector>
+
+#include "adapters/builder_registry.h"
+#include "adapters/in/triangle_scene.h"
+#include "cuda/metrics/tree_stats.h"
+#include "cuda/metrics/validate.h"
+
+namespace kmbvh {
+
+struct LoadedScene {
+  std::string name;
+  size_t triangles = 0;
+  size_t dropped = 0;  // triangles left out (non-finite vertices)
+  PrimitiveSet prims;
+  double load_ms = 0;
+};
+
+// A path, a name in the scene folder, or "" / "default" for the embedded scene.
+// Throws SceneError.
+LoadedScene load_scene_argument(const std::string& argument);
+
+struct MeasureOptions {
+  int runs = 5;
+  int warmup = 1;
+  std::function<void(const std::string&)> progress;  // optional
+};
+
+struct Measurement {
+  std::string scene;
+  size_t triangles = 0;
+  BuilderConfig config;
+  int threads = 0;
+  std::vector<double> build_ms_runs;
+  double build_ms = 0;  // median of the runs
+  double sah_cost = 0;
+  TreeStats stats;
+  ValidationReport validation;
+  double peak_rss_mb = 0;              // the process's high-water mark during the builds
+  double build_memory_mb = 0;          // that mark minus the resident size before them
+  double build_bytes_per_triangle = 0;
+  BuildInfo info;                      // of the last run
+};
+
+Measurement measure(const LoadedScene& scene, const BuilderConfig& config, const MeasureOptions& options);
+
+double median(std::vector<double> values);
+
+}  // namespace kmbvh

@@ -1,0 +1,140 @@
+#include "report.h"
+
+#include <fmt/format.h>
+#include <fmt/ranges.h>
+
+namespace kmbvh {
+namespace {
+
+const Measurement* find_label(const std::vector<Measurement>& rows, const std::string& label) {
+  for (const Measurement& r : rows)
+    if (r.config.label() == label) return &r;
+  return nullptr;
+}
+
+std::string ratio_text(double value, double reference) {
+  return reference > 0 ? fmt::format("{:.2f}", value / reference) : "-";
+}
+
+}  // namespace
+
+std::optional<PaperFigures> paper_figures_for(const Measurement& m) {
+  const BuilderConfig& c = m.config;
+  if (c.builder == "kmeans") {
+    const bool as_paper = !c.preset.empty() && c.kmeans.metric == ClusterMetric::Means && !c.kmeans.wide &&
+                          c.max_leaf_size == 8;
+    return as_paper ? paper_figures(m.scene, c.preset) : std::nullopt;
+  }
+  return paper_figures(m.scene, c.builder);
+}
+
+nlohmann::json to_json(const Measurement& m) {
+  const BuilderConfig& c = m.config;
+  nlohmann::json params = {{"max_leaf_size", c.max_leaf_size}};
+  if (c.builder == "kmeans") {
+    params.update({{"k", c.kmeans.k}, {"p", c.kmeans.p}, {"i", c.kmeans.i}, {"seed", c.kmeans.seed},
+                   {"metric", to_string(c.kmeans.metric)}, {"wide", c.kmeans.wide},
+                   {"preset", c.preset.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.preset)},
+                   {"backend", to_string(c.backend)}});
+  }
+  nlohmann::json phases = nlohmann::json::object();
+  for (const auto& [name, ms] : m.info.phase_ms) phases[name] = ms;
+  nlohmann::json j = {
+      {"scene", m.scene},
+      {"triangles", m.triangles},
+      {"builder", c.label()},
+      {"builder_name", c.builder},
+      {"params", params},
+      {"threads", m.threads},
+      {"build_ms", m.build_ms},
+      {"build_ms_runs", m.build_ms_runs},
+      {"sah_cost", m.sah_cost},
+      {"nodes", m.stats.nodes},
+      {"leaves", m.stats.leaves},
+      {"max_depth", m.stats.max_depth},
+      {"max_leaf_size", m.stats.max_leaf_size},
+      {"mean_leaf_size", m.stats.mean_leaf_size},
+      {"leaf_size_histogram", m.stats.leaf_size_histogram},
+      {"valid", m.validation.ok()},
+      {"validation", m.validation.summary()},
+      {"peak_rss_mb", m.peak_rss_mb},
+      {"build_memory_mb", m.build_memory_mb},
+      {"build_bytes_per_triangle", m.build_bytes_per_triangle},
+      {"phases_ms", phases},
+      {"levels", m.info.levels},
+      {"forced_splits", m.info.forced_splits},
+  };
+  if (const auto paper = paper_figures_for(m)) {
+    j["paper_sah_cost"] = paper->sah_cost;
+    j["sah_cost_over_paper"] = m.sah_cost / paper->sah_cost;
+  }
+  return j;
+}
+
+void print_measurement(const Measurement& m) {
+  const BuilderConfig& c = m.config;
+  std::string params = fmt::format("m={}", c.max_leaf_size);
+  if (c.builder == "kmeans")
+    params = fmt::format("k={} p={} i={} m={} seed={} {}{}, {} backend", c.kmeans.k, c.kmeans.p, c.kmeans.i,
+                         c.max_leaf_size, c.kmeans.seed, to_string(c.kmeans.metric), c.kmeans.wide ? ", wide" : "",
+                         to_string(c.backend));
+  std::vector<std::string> runs, phases, histogram;
+  for (double ms : m.build_ms_runs) runs.push_back(fmt::format("{:.1f}", ms));
+  for (const auto& [name, ms] : m.info.phase_ms) phases.push_back(fmt::format("{} {:.1f}", name, ms));
+  for (size_t s = 0; s < m.stats.leaf_size_histogram.size(); ++s)
+    if (m.stats.leaf_size_histogram[s]) histogram.push_back(fmt::format("{}:{}", s, m.stats.leaf_size_histogram[s]));
+  const auto paper = paper_figures_for(m);
+
+  fmt::print("scene          {} ({} triangles)\n", m.scene, m.triangles);
+  fmt::print("builder        {} ({})\n", c.label(), params);
+  fmt::print("threads        {}\n", m.threads);
+  fmt::print("build          {:.2f} ms (median of {} runs: {})\n", m.build_ms, m.build_ms_runs.size(),
+             fmt::join(runs, " "));
+  fmt::print("SAH cost       {:.2f}{}\n", m.sah_cost,
+             paper ? fmt::format("   (paper {:.0f}, ratio {:.3f})", paper->sah_cost, m.sah_cost / paper->sah_cost) : "");
+  fmt::print("nodes          {} ({} interior, {} leaves)\n", m.stats.nodes, m.stats.interior_nodes, m.stats.leaves);
+  fmt::print("depth          {} (root at 0)\n", m.stats.max_depth);
+  fmt::print("leaf sizes     max {}, mean {:.2f}   [{}]\n", m.stats.max_leaf_size, m.stats.mean_leaf_size,
+             fmt::join(histogram, " "));
+  fmt::print("memory         peak RSS {:.1f} MB; build {:.1f} MB = {:.1f} bytes/triangle\n", m.peak_rss_mb,
+             m.build_memory_mb, m.build_bytes_per_triangle);
+  fmt::print("phases (ms)    {}\n", fmt::join(phases, ", "));
+  fmt::print("validation     {}\n", m.validation.summary());
+}
+
+void print_scene_table(const std::vector<Measurement>& rows, const std::string& reference) {
+  if (rows.empty()) return;
+  const Measurement* ref = find_label(rows, reference);
+  const Measurement& first = rows.front();
+  fmt::print("\n{}: {} triangles, {} threads, median of {} runs\n", first.scene, first.triangles, first.threads,
+             first.build_ms_runs.size());
+  fmt::print("{:<22} {:>9} {:>7} {:>9} {:>11} {:>9} {:>8} {:>6} {:>6}  {}\n", "builder", "SAH cost", "paper",
+             "SAH/paper", "build ms", "ratio", "B/tri", "depth", "leaf", "valid");
+  for (const Measurement& m : rows) {
+    const auto paper = paper_figures_for(m);
+    fmt::print("{:<22} {:>9.2f} {:>7} {:>9} {:>11.2f} {:>9} {:>8.1f} {:>6} {:>6}  {}\n", m.config.label(),
+               m.sah_cost, paper ? fmt::format("{:.0f}", paper->sah_cost) : "-",
+               paper ? fmt::format("{:.3f}", m.sah_cost / paper->sah_cost) : "-", m.build_ms,
+               ref ? ratio_text(m.build_ms, ref->build_ms) : "-", m.build_bytes_per_triangle, m.stats.max_depth,
+               m.stats.max_leaf_size, m.validation.ok() ? "yes" : "NO: " + m.validation.summary());
+  }
+  if (ref) fmt::print("ratio: build time over {} in this run\n", reference);
+}
+
+std::string csv_header() {
+  return "scene,triangles,builder,threads,build_ms,build_ms_over_reference,sah_cost,paper_sah_cost,nodes,leaves,"
+         "max_depth,max_leaf_size,build_bytes_per_triangle,peak_rss_mb,valid";
+}
+
+std::string csv_row(const Measurement& m, const std::vector<Measurement>& same_scene, const std::string& reference) {
+  const Measurement* ref = find_label(same_scene, reference);
+  const auto paper = paper_figures_for(m);
+  return fmt::format("{},{},\"{}\",{},{:.4f},{},{:.4f},{},{},{},{},{},{:.2f},{:.2f},{}", m.scene, m.triangles,
+                     m.config.label(), m.threads, m.build_ms,
+                     ref && ref->build_ms > 0 ? fmt::format("{:.4f}", m.build_ms / ref->build_ms) : "",
+                     m.sah_cost, paper ? fmt::format("{:.0f}", paper->sah_cost) : "", m.stats.nodes, m.stats.leaves,
+                     m.stats.max_depth, m.stats.max_leaf_size, m.build_bytes_per_triangle, m.peak_rss_mb,
+                     m.validation.ok() ? "true" : "false");
+}
+
+}  // namespace kmbvh

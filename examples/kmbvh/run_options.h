@@ -1,0 +1,12 @@
+#pragma once
+
+#include "adapters/builder_registry.h"
+#include "commands.h"
+
+namespace kmbvh {
+
+void add_run_options(CLI::App& cmd, RunOptions& run);
+void apply_run_options(const RunOptions& run);
+BuilderConfig builder_config(const BuilderOptions& options, const RunOptions& run);
+
+}  // namespace kmbvh

@@ -1,0 +1,39 @@
+// A reference ray query for tests: brute force over all triangles, and a plain stack
+// traversal of any Bvh. Both use the same triangle test, in double precision, and the
+// traversal's box test is conservative, so on a correct tree the two give the same hit.
+#pragma once
+
+#include <cstdint>
+#include <limits>
+
+#include "adapters/in/triangle_scene.h"
+#include "cuda/core/bvh.h"
+
+namespace kmbvh::test {
+
+struct Ray {
+  Vec3 origin, direction;
+  float tmin = 0.0f, tmax = std::numeric_limits<float>::infinity();
+};
+
+struct Hit {
+  double t = std::numeric_limits<double>::infinity();
+  uint32_t triangle = UINT32_MAX;  // index in the scene
+  bool found() const { return triangle != UINT32_MAX; }
+};
+
+bool intersect_triangle(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, double& t);
+
+Hit closest_hit_brute_force(const TriangleScene& scene, const Ray& ray);
+
+// prims: the PrimitiveSet the tree was built over (ids map back to scene triangles).
+Hit closest_hit_bvh(const Bvh& bvh, const PrimitiveSet& prims, const TriangleScene& scene, const Ray& ray);
+
+// Rays from random points around the scene towards random points inside it.
+Ray random_ray(const Aabb& bounds, uint32_t seed, uint32_t index);
+
+// Rays from random points around the scene towards a random triangle (most of them hit
+// something, even in a sparse scene).
+Ray ray_towards_triangle(const TriangleScene& scene, uint32_t seed, uint32_t index);
+
+}  // namespace kmbvh::test

@@ -1,0 +1,109 @@
+// The kmbvh command as a user runs it: JSON fields of `build --json`, the embedded default
+// scene, `bench`, and exit code 2 with a one-line message for a file that cannot be read.
+#include <gtest/gtest.h>
+#include <sys/wait.h>
+
+#include <cstdio>
+#include <filesystem>
+#include <fstream>
+#include <nlohmann/json.hpp>
+
+namespace {
+
+namespace fs = std::filesystem;
+
+struct Result {
+  int exit_code = -1;
+  std::string out, err;
+};
+
+Result run(const std::string& args) {
+  const fs::path err_file = fs::temp_directory_path() / "kmbvh-cli-stderr.txt";
+  const std::string command = std::string(KMBVH_CLI) + " " + args + " 2>" + err_file.string();
+  Result r;
+  FILE* pipe = popen(command.c_str(), "r");
+  char buffer[4096];
+  for (size_t n; (n = fread(buffer, 1, sizeof buffer, pipe)) > 0;) r.out.append(buffer, n);
+  const int status = pclose(pipe);
+  r.exit_code = WIFEXITED(status) ? WEXITSTATUS(status) : -1;
+  std::ifstream in(err_file);
+  r.err.assign(std::istreambuf_iterator<char>(in), {});
+  return r;
+}
+
+fs::path small_obj() {
+  const fs::path path = fs::temp_directory_path() / "kmbvh-cli-grid.obj";
+  std::ofstream out(path);
+  for (int i = 0; i <= 40; ++i)
+    for (int j = 0; j <= 40; ++j) out << "v " << i << " " << (i * j % 7) * 0.1 << " " << j << "\n";
+  for (int i = 0; i < 40; ++i)
+    for (int j = 0; j < 40; ++j) {
+      const int a = i * 41 + j + 1;
+      out << "f " << a << " " << a + 41 << " " << a + 42 << " " << a + 1 << "\n";
+    }
+  return path;
+}
+
+TEST(Cli, BuildJsonHasEveryField) {
+  const Result r = run("build " + small_obj().string() + " --builder kmeans --k 16 --p 5 --i 3 --metric medians "
+                       "--threads 2 --runs 3 --json -q");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  for (const char* field : {"scene", "triangles", "builder", "params", "threads", "build_ms", "build_ms_runs",
+                            "sah_cost", "nodes", "leaves", "max_depth", "max_leaf_size", "valid", "peak_rss_mb"})
+    EXPECT_TRUE(j.contains(field)) << field;
+  EXPECT_EQ(j["triangles"], 3200);
+  EXPECT_EQ(j["threads"], 2);
+  EXPECT_EQ(j["build_ms_runs"].size(), 3u);
+  EXPECT_EQ(j["params"]["k"], 16);
+  EXPECT_EQ(j["params"]["metric"], "medians");
+  EXPECT_TRUE(j["valid"].get<bool>()) << j["validation"];
+  EXPECT_GT(j["sah_cost"].get<double>(), 0.0);
+}
+
+TEST(Cli, BuildWithoutSceneUsesTheDefaultScene) {
+  const Result r = run("build --preset Q1 --runs 1 --warmup 0 --json -q");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["scene"], "default");
+  EXPECT_GE(j["triangles"].get<int>(), 200000);
+  EXPECT_TRUE(j["valid"].get<bool>());
+}
+
+TEST(Cli, EmbreeBuilderAndTable) {
+  const Result r = run("build " + small_obj().string() + " --builder embree-medium --runs 1");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_NE(r.out.find("embree-medium"), std::string::npos);
+  EXPECT_NE(r.out.find("validation     valid"), std::string::npos) << r.out;
+}
+
+TEST(Cli, BenchPrintsOneRowPerBuilder) {
+  const fs::path csv = fs::temp_directory_path() / "kmbvh-cli-bench.csv";
+  const Result r = run("bench " + small_obj().string() + " --builders Q1,Q2,embree-medium --runs 1 --csv " +
+                       csv.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  for (const char* row : {"kmeans Q1", "kmeans Q2", "embree-medium"}) EXPECT_NE(r.out.find(row), std::string::npos);
+  std::ifstream in(csv);
+  int lines = 0;
+  for (std::string line; std::getline(in, line);) ++lines;
+  EXPECT_EQ(lines, 4);
+}
+
+TEST(Cli, UnreadableFileExitsWithTwoAndNamesIt) {
+  const fs::path garbage = fs::temp_directory_path() / "kmbvh-cli-garbage.glb";
+  std::ofstream(garbage, std::ios::binary) << "not a gltf file at all";
+  for (const std::string& file : {garbage.string(), std::string("/nonexistent/scene.glb")}) {
+    const Result r = run("build " + file + " -q");
+    EXPECT_EQ(r.exit_code, 2) << file;
+    EXPECT_NE(r.err.find(file), std::string::npos) << r.err;
+    EXPECT_EQ(std::count(r.err.begin(), r.err.end(), '\n'), 1) << r.err;
+  }
+}
+
+TEST(Cli, BadArgumentsExitWithTwo) {
+  EXPECT_EQ(run("build --builder nonsense -q").exit_code, 2);
+  EXPECT_EQ(run("build --k 1 -q").exit_code, 2);
+  EXPECT_EQ(run("build --preset Q9 -q").exit_code, 2);
+}
+
+}  // namespace

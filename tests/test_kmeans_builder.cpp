@@ -1,0 +1,161 @@
+// The k-means builder end to end (issue #2): valid trees for every preset, metric and
+// output arity on random scenes, free parameters, determinism across thread counts, and
+// the degenerate inputs.
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include "cuda/core/threads.h"
+#include "cuda/kmeans/kmeans_builder.h"
+#include "cuda/metrics/tree_stats.h"
+#include "cuda/metrics/validate.h"
+#include "support/scenes.h"
+
+namespace kmbvh {
+namespace {
+
+ValidationLimits limits_for(const KMeansParams& p) {
+  ValidationLimits limits;
+  limits.max_leaf_size = p.max_leaf_size;
+  limits.max_arity = p.wide ? p.k : 2;
+  return limits;
+}
+
+void expect_valid(const PrimitiveSet& prims, const KMeansParams& params, const std::string& what) {
+  BuildInfo info;
+  const Bvh bvh = build_kmeans(prims, params, Backend::Cpu, &info);
+  const ValidationReport report = validate(bvh, prims, limits_for(params));
+  EXPECT_TRUE(report.ok()) << what << " k=" << params.k << " p=" << params.p << " i=" << params.i
+                           << " m=" << params.max_leaf_size << " " << to_string(params.metric)
+                           << (params.wide ? " wide" : "") << ": " << report.summary();
+}
+
+bool same_tree(const Bvh& a, const Bvh& b) {
+  return a.nodes.size() == b.nodes.size() && a.prim_indices == b.prim_indices &&
+         std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(BvhNode)) == 0;
+}
+
+class EveryPreset : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(EveryPreset, ValidOnRandomScenes) {
+  const PrimitiveSet random = make_primitive_set(test::random_triangles(20000, 1));
+  const PrimitiveSet clustered = make_primitive_set(test::clustered_triangles(20000, 2));
+  for (ClusterMetric metric : {ClusterMetric::Means, ClusterMetric::Medians})
+    for (bool wide : {false, true}) {
+      KMeansParams params = *kmeans_preset(GetParam());
+      params.metric = metric;
+      params.wide = wide;
+      expect_valid(random, params, "random");
+      expect_valid(clustered, params, "clustered");
+    }
+}
+
+TEST_P(EveryPreset, SameTreeWithOneAndTwoThreads) {
+  const PrimitiveSet prims = make_primitive_set(test::clustered_triangles(30000, 3));
+  for (ClusterMetric metric : {ClusterMetric::Means, ClusterMetric::Medians}) {
+    KMeansParams params = *kmeans_preset(GetParam());
+    params.metric = metric;
+    set_thread_count(1);
+    const Bvh one = build_kmeans(prims, params);
+    set_thread_count(2);
+    const Bvh two = build_kmeans(prims, params);
+    set_thread_count(0);
+    EXPECT_TRUE(same_tree(one, two)) << to_string(metric);
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(KMeans, EveryPreset, ::testing::Values("Q1", "Q2", "Q3", "Q4", "Q5"));
+
+TEST(KMeansBuilder, FreeParameters) {
+  const PrimitiveSet prims = make_primitive_set(test::random_triangles(5000, 4));
+  struct Case {
+    uint32_t k, p, i, m;
+  };
+  for (const Case c : {Case{2, 1, 0, 8}, Case{3, 2, 1, 8}, Case{5, 5, 3, 4}, Case{64, 1, 1, 1}, Case{7, 9, 0, 16},
+                       Case{2, 3, 20, 1}, Case{33, 5, 2, 8}}) {
+    KMeansParams params;
+    params.k = c.k;
+    params.p = c.p;
+    params.i = c.i;
+    params.max_leaf_size = c.m;
+    expect_valid(prims, params, "free parameters");
+    params.wide = true;
+    expect_valid(prims, params, "free parameters");
+  }
+}
+
+TEST(KMeansBuilder, SeedChangesTreeButNotValidity) {
+  const PrimitiveSet prims = make_primitive_set(test::random_triangles(5000, 5));
+  KMeansParams a = *kmeans_preset("Q2"), b = a;
+  b.seed = 12345;
+  expect_valid(prims, b, "seeded");
+  EXPECT_FALSE(same_tree(build_kmeans(prims, a), build_kmeans(prims, b)));
+}
+
+TEST(KMeansBuilder, ReportsPhasesAndLevels) {
+  const PrimitiveSet prims = make_primitive_set(test::random_triangles(5000, 6));
+  BuildInfo info;
+  build_kmeans(prims, *kmeans_preset("Q2"), Backend::Cpu, &info);
+  EXPECT_GT(info.levels, 2u);
+  std::vector<std::string> names;
+  for (const auto& [name, ms] : info.phase_ms) names.push_back(name);
+  for (const char* phase : {"initialise", "assign", "update", "partition", "agglomerate", "finish"})
+    EXPECT_NE(std::find(names.begin(), names.end(), phase), names.end()) << phase;
+}
+
+TEST(KMeansBuilder, RejectsBadParameters) {
+  const PrimitiveSet prims = make_primitive_set(test::random_triangles(100, 7));
+  KMeansParams params;
+  params.k = 1;
+  EXPECT_THROW(build_kmeans(prims, params), std::invalid_argument);
+  params.k = 65;
+  EXPECT_THROW(build_kmeans(prims, params), std::invalid_argument);
+  params = KMeansParams{};
+  params.p = 0;
+  EXPECT_THROW(build_kmeans(prims, params), std::invalid_argument);
+  params = KMeansParams{};
+  params.max_leaf_size = 0;
+  EXPECT_THROW(build_kmeans(prims, params), std::invalid_argument);
+}
+
+// Degenerate inputs: every preset, both metrics, must finish with a valid tree.
+class Degenerate : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(Degenerate, TinySets) {
+  for (uint32_t n : {0u, 1u, 2u, 3u, 8u, 9u}) {
+    const PrimitiveSet prims = make_primitive_set(test::random_triangles(n, 8));
+    KMeansParams params = *kmeans_preset(GetParam());
+    expect_valid(prims, params, "n=" + std::to_string(n));
+    params.max_leaf_size = 1;
+    expect_valid(prims, params, "m=1 n=" + std::to_string(n));
+  }
+}
+
+TEST_P(Degenerate, HundredThousandIdenticalTriangles) {
+  const PrimitiveSet prims = make_primitive_set(test::identical_triangles(100000));
+  for (ClusterMetric metric : {ClusterMetric::Means, ClusterMetric::Medians}) {
+    KMeansParams params = *kmeans_preset(GetParam());
+    params.metric = metric;
+    BuildInfo info;
+    const Bvh bvh = build_kmeans(prims, params, Backend::Cpu, &info);
+    EXPECT_TRUE(validate(bvh, prims, limits_for(params)).ok());
+    EXPECT_GT(info.forced_splits, 0u);
+    EXPECT_LE(tree_stats(bvh).max_depth, 64u);  // split by position: balanced
+  }
+}
+
+TEST_P(Degenerate, SharedCentroidAndZeroArea) {
+  const PrimitiveSet nested = make_primitive_set(test::shared_centroid_triangles(20000));
+  const PrimitiveSet flat = make_primitive_set(test::zero_area_triangles(20000, 9));
+  for (ClusterMetric metric : {ClusterMetric::Means, ClusterMetric::Medians}) {
+    KMeansParams params = *kmeans_preset(GetParam());
+    params.metric = metric;
+    expect_valid(nested, params, "shared centroid");
+    expect_valid(flat, params, "zero area");
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(KMeans, Degenerate, ::testing::Values("Q1", "Q2", "Q3", "Q4", "Q5"));
+
+}  // namespace
+}  // namespace kmbvh

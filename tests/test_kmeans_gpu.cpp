@@ -1,0 +1,45 @@
+// The k-means builder on the GPU backend: the same kernels, compiled by nvcc. Runs where a
+// CUDA device is present (the device machine), and is skipped, saying so, elsewhere.
+#include <gtest/gtest.h>
+
+#include "cuda/kmeans/kmeans_builder.h"
+#include "cuda/metrics/sah.h"
+#include "cuda/metrics/validate.h"
+#include "support/scenes.h"
+
+namespace kmbvh {
+namespace {
+
+TEST(KMeansGpu, ValidTreesAsGoodAsTheCpuBackend) {
+  if (!cuda_device_available()) GTEST_SKIP() << "no CUDA device: the GPU backend is compiled but not run here";
+  const PrimitiveSet prims = make_primitive_set(test::clustered_triangles(200000, 51));
+  for (const char* preset : {"Q1", "Q2", "Q3", "Q4", "Q5"})
+    for (ClusterMetric metric : {ClusterMetric::Means, ClusterMetric::Medians})
+      for (bool wide : {false, true}) {
+        KMeansParams params = *kmeans_preset(preset);
+        params.metric = metric;
+        params.wide = wide;
+        const Bvh gpu = build_kmeans(prims, params, Backend::Cuda);
+        const Bvh cpu = build_kmeans(prims, params, Backend::Cpu);
+        ValidationLimits limits;
+        limits.max_arity = wide ? params.k : 2;
+        const ValidationReport report = validate(gpu, prims, limits);
+        EXPECT_TRUE(report.ok()) << preset << ": " << report.summary();
+        // Integer sums and counter-based draws make the trees nearly identical; float
+        // contraction on the device may still break a tie differently.
+        EXPECT_NEAR(sah_cost(gpu) / sah_cost(cpu), 1.0, 0.02) << preset << " " << to_string(metric);
+      }
+}
+
+TEST(KMeansGpu, DegenerateInputs) {
+  if (!cuda_device_available()) GTEST_SKIP() << "no CUDA device";
+  for (const TriangleScene& scene : {test::identical_triangles(100000), test::shared_centroid_triangles(20000),
+                                     test::zero_area_triangles(20000, 52), test::random_triangles(2, 53)}) {
+    const PrimitiveSet prims = make_primitive_set(scene);
+    const Bvh bvh = build_kmeans(prims, *kmeans_preset("Q3"), Backend::Cuda);
+    EXPECT_TRUE(validate(bvh, prims, {}).ok()) << scene.name;
+  }
+}
+
+}  // namespace
+}  // namespace kmbvh

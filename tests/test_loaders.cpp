@@ -1,0 +1,206 @@
+// The adapters in: glTF (written here with tinygltf itself), OBJ, the default scene, and
+// the errors a broken file must give (one line, naming the file).
+#include <gtest/gtest.h>
+#include <tiny_gltf.h>
+
+#include <cstring>
+#include <filesystem>
+#include <fstream>
+
+#include "adapters/in/default_scene.h"
+#include "adapters/in/load_scene.h"
+#include "support/printers.h"
+
+namespace kmbvh {
+namespace {
+
+namespace fs = std::filesystem;
+
+fs::path temp_file(const std::string& name) {
+  const fs::path dir = fs::temp_directory_path() / "kmbvh-tests";
+  fs::create_directories(dir);
+  return dir / name;
+}
+
+void write_text(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
+
+// One triangle, drawn by three nodes: translated, scaled by a matrix, and a child of the
+// scaled one. The mesh also has a line primitive, which must be skipped with a warning.
+tinygltf::Model three_node_model(uint16_t third_index = 2, size_t position_count = 3) {
+  tinygltf::Model m;
+  const float positions[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  const uint16_t indices[3] = {0, 1, third_index};
+  tinygltf::Buffer buffer;
+  buffer.data.resize(sizeof positions + sizeof indices + 2);
+  std::memcpy(buffer.data.data(), positions, sizeof positions);
+  std::memcpy(buffer.data.data() + sizeof positions, indices, sizeof indices);
+  m.buffers.push_back(buffer);
+  tinygltf::BufferView positions_view, indices_view;
+  positions_view.buffer = 0;
+  positions_view.byteLength = sizeof positions;
+  indices_view.buffer = 0;
+  indices_view.byteOffset = sizeof positions;
+  indices_view.byteLength = sizeof indices;
+  m.bufferViews = {positions_view, indices_view};
+  tinygltf::Accessor pos, idx;
+  pos.bufferView = 0;
+  pos.componentType = TINYGLTF_COMPONENT_TYPE_FLOAT;
+  pos.type = TINYGLTF_TYPE_VEC3;
+  pos.count = position_count;
+  pos.minValues = {0, 0, 0};
+  pos.maxValues = {1, 1, 0};
+  idx.bufferView = 1;
+  idx.componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_SHORT;
+  idx.type = TINYGLTF_TYPE_SCALAR;
+  idx.count = 3;
+  m.accessors = {pos, idx};
+  tinygltf::Primitive tri, lines;
+  tri.attributes["POSITION"] = 0;
+  tri.indices = 1;
+  tri.mode = TINYGLTF_MODE_TRIANGLES;
+  lines = tri;
+  lines.mode = TINYGLTF_MODE_LINE;
+  tinygltf::Mesh mesh;
+  mesh.primitives = {tri, lines};
+  m.meshes.push_back(mesh);
+  tinygltf::Node translated, scaled, child;
+  translated.mesh = 0;
+  translated.translation = {10, 0, 0};
+  scaled.mesh = 0;
+  scaled.matrix = {2, 0, 0, 0, 0, 2, 0, 0, 0, 0, 2, 0, 0, 0, 0, 1};
+  scaled.children = {2};
+  child.mesh = 0;
+  child.translation = {0, 5, 0};
+  m.nodes = {translated, scaled, child};
+  tinygltf::Scene scene;
+  scene.nodes = {0, 1};
+  m.scenes.push_back(scene);
+  m.defaultScene = 0;
+  m.asset.version = "2.0";
+  return m;
+}
+
+fs::path write_model(const tinygltf::Model& model, const std::string& name, bool binary) {
+  const fs::path path = temp_file(name);
+  tinygltf::TinyGLTF writer;
+  EXPECT_TRUE(writer.WriteGltfSceneToFile(&model, path.string(), false, true, true, binary));
+  return path;
+}
+
+std::string load_error(const fs::path& path) {
+  try {
+    load_scene_file(path.string());
+  } catch (const SceneError& e) {
+    return e.what();
+  }
+  return "";
+}
+
+TEST(GltfLoader, AppliesNodeTransformsAndSkipsNonTriangles) {
+  for (bool binary : {true, false}) {
+    const fs::path path = write_model(three_node_model(), binary ? "nodes.glb" : "nodes.gltf", binary);
+    const TriangleScene s = load_scene_file(path.string());
+    ASSERT_EQ(s.size(), 3u) << path;
+    EXPECT_EQ(s.positions[s.triangles[0][1]], Vec3(11, 0, 0));  // translated by 10
+    EXPECT_EQ(s.positions[s.triangles[1][2]], Vec3(0, 2, 0));   // scaled by 2
+    EXPECT_EQ(s.positions[s.triangles[2][1]], Vec3(2, 10, 0));  // (1,0,0) + (0,5,0), then scaled
+    ASSERT_EQ(s.warnings.size(), 3u);  // one skipped line primitive per node
+    EXPECT_NE(s.warnings[0].find("not triangles"), std::string::npos);
+    EXPECT_EQ(s.name, path.filename().string());
+  }
+}
+
+TEST(GltfLoader, IndexOutOfRangeIsAnError) {
+  const fs::path path = write_model(three_node_model(7), "bad-index.glb", true);
+  const std::string error = load_error(path);
+  EXPECT_NE(error.find(path.string()), std::string::npos) << error;
+  EXPECT_NE(error.find("index 7 out of range"), std::string::npos) << error;
+}
+
+TEST(GltfLoader, AccessorPastItsBufferIsAnError) {
+  const fs::path path = write_model(three_node_model(2, 1000), "long-accessor.glb", true);
+  const std::string error = load_error(path);
+  EXPECT_NE(error.find(path.string()), std::string::npos) << error;
+  EXPECT_FALSE(error.empty());
+}
+
+TEST(GltfLoader, TruncatedGarbageAndMissingFilesAreErrors) {
+  const fs::path good = write_model(three_node_model(), "good.glb", true);
+  std::string bytes;
+  {
+    std::ifstream in(good, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const fs::path truncated = temp_file("truncated.glb");
+  std::ofstream(truncated, std::ios::binary) << bytes.substr(0, bytes.size() / 2);
+  const fs::path garbage = temp_file("garbage.glb");
+  std::ofstream(garbage, std::ios::binary) << std::string(1000, '\x7f');
+  const fs::path json = temp_file("broken.gltf");
+  write_text(json, "{ \"asset\": { \"version\": \"2.0\" }, \"meshes\": [ { ");
+  for (const fs::path& p : {truncated, garbage, json, temp_file("missing.glb")}) {
+    const std::string error = load_error(p);
+    EXPECT_NE(error.find(p.string()), std::string::npos) << p << ": " << error;
+    EXPECT_EQ(error.find('\n'), std::string::npos) << "one line: " << error;
+  }
+  EXPECT_NE(load_error(temp_file("missing.glb")).find("no such file"), std::string::npos);
+}
+
+TEST(ObjLoader, FanTriangulatesPolygonsAndResolvesRelativeIndices) {
+  const fs::path path = temp_file("polygons.obj");
+  write_text(path,
+             "v 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\nv 0.5 1.5 0\n"
+             "f 1 2 3 4\n"
+             "f 1/1 2/2 3/3 4/4 5/5\n"
+             "f -3 -2 -1\n");
+  const TriangleScene s = load_scene_file(path.string());
+  ASSERT_EQ(s.size(), 6u);
+  EXPECT_EQ(s.triangles[0], (Triangle{0, 1, 2}));
+  EXPECT_EQ(s.triangles[1], (Triangle{0, 2, 3}));
+  EXPECT_EQ(s.triangles[4], (Triangle{0, 3, 4}));
+  EXPECT_EQ(s.triangles[5], (Triangle{2, 3, 4}));
+}
+
+TEST(ObjLoader, BadIndexAndMissingFileAreErrors) {
+  const fs::path path = temp_file("bad.obj");
+  write_text(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99\n");
+  const std::string error = load_error(path);
+  EXPECT_NE(error.find(path.string()), std::string::npos) << error;
+  EXPECT_NE(load_error(temp_file("missing.obj")).find("no such file"), std::string::npos);
+  EXPECT_NE(load_error(temp_file("scene.ply")).find("unknown scene format"), std::string::npos);
+}
+
+TEST(DefaultScene, LargeUnevenAndDeterministic) {
+  const TriangleScene a = make_default_scene();
+  const TriangleScene b = make_default_scene();
+  EXPECT_GE(a.size(), 200000u);
+  EXPECT_EQ(a.positions.size(), b.positions.size());
+  EXPECT_TRUE(std::equal(a.positions.begin(), a.positions.end(), b.positions.begin()));
+  size_t dropped = 1;
+  const PrimitiveSet prims = make_primitive_set(a, &dropped);
+  EXPECT_EQ(dropped, 0u);
+  // Uneven: triangle box sizes span several orders of magnitude.
+  float smallest = INFINITY, largest = 0;
+  for (const Aabb& box : prims.boxes) {
+    const float size = length(box.extent());
+    smallest = std::min(smallest, size);
+    largest = std::max(largest, size);
+  }
+  EXPECT_GT(largest / smallest, 1000.0f);
+  EXPECT_GT(length(a.bounds().extent()), 1000.0f);  // the far outlier makes empty space
+}
+
+TEST(PrimitiveSet, DropsNonFiniteTriangles) {
+  TriangleScene s;
+  s.add_triangle({0, 0, 0}, {1, 0, 0}, {0, 1, 0});
+  s.add_triangle({0, 0, 0}, {NAN, 0, 0}, {0, 1, 0});
+  s.add_triangle({0, 0, 0}, {INFINITY, 0, 0}, {0, 1, 0});
+  s.add_triangle({2, 0, 0}, {3, 0, 0}, {2, 1, 0});
+  size_t dropped = 0;
+  const PrimitiveSet prims = make_primitive_set(s, &dropped);
+  EXPECT_EQ(dropped, 2u);
+  ASSERT_EQ(prims.size(), 2u);
+  EXPECT_EQ(prims.ids[1].prim, 3u);
+}
+
+}  // namespace
+}  // namespace kmbvh

@@ -1,0 +1,155 @@
+// The partition of a level by cluster (issue #2): the final assignment counts per piece,
+// PlaceClusters turns counts into cursors, ScatterPiece moves primitives. Checked on a
+// hand-made level of two segments, one of them spread over several pieces.
+#include <gtest/gtest.h>
+
+#include <numeric>
+#include <vector>
+
+#include "cuda/kmeans/assign.h"
+#include "cuda/kmeans/partition.h"
+#include "cuda/kmeans/setup.h"
+#include "support/printers.h"
+#include "support/scenes.h"
+
+namespace kmbvh {
+namespace {
+
+struct HostLevel {
+  std::vector<Aabb> boxes, boxes_out, reps;
+  std::vector<uint32_t> ids, ids_out, final_ids;
+  std::vector<uint8_t> cluster_of;
+  std::vector<Segment> segments;
+  std::vector<SegmentSizes> offsets;
+  std::vector<Piece> pieces;
+  std::vector<uint32_t> counters, counts, begin, cluster_segment;
+  std::vector<ClusterSums> sums;
+  std::vector<OrderedBounds> bounds;
+
+  ClusterArrays clusters() {
+    return {reps.data(), sums.data(), counts.data(), bounds.data(), begin.data(), cluster_segment.data()};
+  }
+  LevelView view() {
+    return {boxes.data(), ids.data(), cluster_of.data(), segments.data(), pieces.data(), counters.data(), clusters()};
+  }
+};
+
+// Two segments: [0, 50) with k = 3 and [50, 1000) with k = 8, pieces of 128.
+HostLevel make_level() {
+  HostLevel l;
+  const uint32_t n = 1000;
+  for (uint32_t i = 0; i < n; ++i) {
+    const Vec3 p(test::random_unit(1, 1, i), test::random_unit(1, 2, i), test::random_unit(1, 3, i));
+    l.boxes.push_back(Aabb(p * 10.0f, p * 10.0f + Vec3(0.1f)));
+  }
+  l.ids.resize(n);
+  std::iota(l.ids.begin(), l.ids.end(), 0u);
+  Segment a, b;
+  a.begin = 0;
+  a.count = 50;
+  a.k = 3;
+  b.begin = 50;
+  b.count = 950;
+  b.k = 8;
+  l.segments = {a, b};
+  for (Segment& s : l.segments)
+    for (uint32_t i = s.begin; i < s.begin + s.count; ++i) s.box.grow(l.boxes[i]);
+
+  const SizesOfSegment sizes{128};
+  l.offsets = {SegmentSizes{}, sizes(a)};
+  const SegmentSizes total = AddSegmentSizes{}(l.offsets[1], sizes(b));
+  l.pieces.resize(total.pieces);
+  l.counters.resize(total.counters);
+  l.counts.assign(total.clusters, 0);
+  l.begin.resize(total.clusters);
+  l.cluster_segment.resize(total.clusters);
+  l.sums.resize(total.clusters);
+  l.bounds.assign(total.clusters, OrderedBounds::empty());
+  l.reps.resize(total.clusters);
+  for (uint32_t s = 0; s < 2; ++s) SetupSegment{l.segments.data(), l.offsets.data(), sizes, l.pieces.data(), l.cluster_segment.data()}(s);
+  for (const Segment& s : l.segments)
+    for (uint32_t c = 0; c < s.k; ++c) l.reps[s.cluster_base + c] = l.boxes[s.begin + 7 * c];
+  l.cluster_of.resize(n);
+  l.boxes_out.resize(n);
+  l.ids_out.resize(n);
+  l.final_ids.resize(n);
+  return l;
+}
+
+TEST(Partition, PiecesCoverSegments) {
+  HostLevel l = make_level();
+  EXPECT_EQ(l.segments[0].piece_count, 1u);
+  EXPECT_EQ(l.segments[1].piece_count, 8u);  // ceil(950 / 128)
+  uint32_t covered = 0;
+  for (const Piece& p : l.pieces) {
+    const Segment& s = l.segments[p.segment];
+    EXPECT_GE(p.begin, s.begin);
+    EXPECT_LE(p.end, s.begin + s.count);
+    EXPECT_LE(p.end - p.begin, 128u);
+    covered += p.end - p.begin;
+  }
+  EXPECT_EQ(covered, 1000u);
+}
+
+TEST(Partition, GroupsByClusterStablyAndCountsMatch) {
+  HostLevel l = make_level();
+  for (uint32_t p = 0; p < l.pieces.size(); ++p) AssignPiece<8, ClusterMetric::Means, AssignPass::Final>{l.view()}(p);
+  const std::vector<uint8_t> assigned = l.cluster_of;
+  for (uint32_t s = 0; s < 2; ++s) PlaceClusters{l.segments.data(), l.pieces.data(), l.counters.data(), l.clusters()}(s);
+  for (uint32_t p = 0; p < l.pieces.size(); ++p)
+    ScatterPiece<8>{l.boxes.data(), l.ids.data(), l.cluster_of.data(), l.segments.data(), l.pieces.data(),
+                    l.counters.data(), l.boxes_out.data(), l.ids_out.data(), l.final_ids.data()}(p);
+
+  for (const Segment& s : l.segments) {
+    // Expected: within the segment, cluster 0's primitives in input order, then cluster 1's...
+    std::vector<uint32_t> expected;
+    for (uint32_t c = 0; c < s.k; ++c) {
+      const uint32_t slot = s.cluster_base + c;
+      uint32_t count = 0;
+      Aabb box;
+      EXPECT_EQ(l.begin[slot], s.begin + uint32_t(expected.size()));
+      for (uint32_t i = s.begin; i < s.begin + s.count; ++i)
+        if (assigned[i] == c) {
+          expected.push_back(i);
+          ++count;
+          box.grow(l.boxes[i]);
+        }
+      EXPECT_EQ(l.counts[slot], count);
+      if (count) {
+        EXPECT_EQ(l.bounds[slot].to_aabb(), box);
+      }
+    }
+    ASSERT_EQ(expected.size(), s.count);
+    for (uint32_t j = 0; j < s.count; ++j) {
+      EXPECT_EQ(l.ids_out[s.begin + j], expected[j]);
+      EXPECT_EQ(l.final_ids[s.begin + j], expected[j]);
+      EXPECT_EQ(l.boxes_out[s.begin + j], l.boxes[expected[j]]);
+    }
+  }
+}
+
+TEST(Partition, SingleClusterIsSplitByIndex) {
+  HostLevel l = make_level();
+  // Every representative of segment 1 the same: all its primitives tie into cluster 0.
+  const Segment& s = l.segments[1];
+  for (uint32_t c = 0; c < s.k; ++c) l.reps[s.cluster_base + c] = l.reps[s.cluster_base];
+  for (uint32_t p = 0; p < l.pieces.size(); ++p) AssignPiece<8, ClusterMetric::Means, AssignPass::Final>{l.view()}(p);
+  EXPECT_EQ(l.counts[s.cluster_base], s.count);
+  for (uint32_t i = 0; i < 2; ++i) DetectSingleCluster{l.segments.data(), l.clusters()}(i);
+  EXPECT_EQ(l.segments[0].split_by_index, 0u);
+  ASSERT_EQ(l.segments[1].split_by_index, 1u);
+  for (uint32_t p = 0; p < l.pieces.size(); ++p)
+    AssignPiece<8, ClusterMetric::Means, AssignPass::SplitByIndex>{l.view()}(p);
+  // k runs of (almost) equal length, in order.
+  uint32_t total = 0;
+  for (uint32_t c = 0; c < s.k; ++c) {
+    EXPECT_GE(l.counts[s.cluster_base + c], s.count / s.k);
+    EXPECT_LE(l.counts[s.cluster_base + c], s.count / s.k + 1);
+    total += l.counts[s.cluster_base + c];
+  }
+  EXPECT_EQ(total, s.count);
+  for (uint32_t i = s.begin + 1; i < s.begin + s.count; ++i) EXPECT_LE(l.cluster_of[i - 1], l.cluster_of[i]);
+}
+
+}  // namespace
+}  // namespace kmbvh

@@ -1,0 +1,61 @@
+// Every builder's tree validates on every real scene in the shared scene folder
+// ($KMBVH_SCENES, default ../shared/scenes). Skipped, saying so, when the folder is absent.
+#include <gtest/gtest.h>
+
+#include <filesystem>
+#include <map>
+
+#include "adapters/builder_registry.h"
+#include "adapters/in/load_scene.h"
+#include "adapters/in/scene_folder.h"
+
+namespace kmbvh {
+namespace {
+
+std::vector<std::string> scene_files() {
+  std::vector<std::string> files;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(scene_folder(), ec)) {
+    const std::string ext = entry.path().extension().string();
+    if (ext == ".glb" || ext == ".gltf" || ext == ".obj") files.push_back(entry.path().string());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+const PrimitiveSet& scene_prims(const std::string& path) {
+  static std::map<std::string, PrimitiveSet> cache;
+  auto it = cache.find(path);
+  if (it == cache.end()) it = cache.emplace(path, make_primitive_set(load_scene_file(path))).first;
+  return it->second;
+}
+
+class EveryScene : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(EveryScene, TreeIsValid) {
+  const auto files = scene_files();
+  if (files.empty()) GTEST_SKIP() << "no scenes in " << scene_folder() << " (set KMBVH_SCENES to the shared scene folder)";
+  std::string spec = GetParam();
+  BuilderConfig config = parse_builder(spec.substr(0, spec.find('+')));
+  if (spec.find("+medians") != std::string::npos) config.kmeans.metric = ClusterMetric::Medians;
+  if (spec.find("+wide") != std::string::npos) config.kmeans.wide = true;
+  for (const std::string& file : files) {
+    const PrimitiveSet& prims = scene_prims(file);
+    const Bvh bvh = run_builder(config, prims);
+    const ValidationReport report = validate(bvh, prims, validation_limits(config));
+    EXPECT_TRUE(report.ok()) << file << " with " << config.label() << ": " << report.summary();
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Scenes, EveryScene,
+                         ::testing::Values("Q1", "Q2", "Q3", "Q4", "Q5", "Q2+medians", "Q3+wide", "embree-low",
+                                           "embree-medium", "embree-high"),
+                         [](const auto& info) {
+                           std::string name = info.param;
+                           for (char& c : name)
+                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                           return name;
+                         });
+
+}  // namespace
+}  // namespace kmbvh
