@@ -8,6 +8,8 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "support/temp_files.h"
+
 namespace {
 
 namespace fs = std::filesystem;
@@ -18,7 +20,8 @@ struct Result {
 };
 
 Result run(const std::string& args) {
-  const fs::path err_file = fs::temp_directory_path() / "kmbvh-cli-stderr.txt";
+  static int calls = 0;
+  const fs::path err_file = kmbvh::test::temp_path("stderr-" + std::to_string(++calls) + ".txt");
   const std::string command = std::string(KMBVH_CLI) + " " + args + " 2>" + err_file.string();
   Result r;
   FILE* pipe = popen(command.c_str(), "r");
@@ -32,7 +35,7 @@ Result run(const std::string& args) {
 }
 
 fs::path small_obj() {
-  const fs::path path = fs::temp_directory_path() / "kmbvh-cli-grid.obj";
+  const fs::path path = kmbvh::test::temp_path("grid.obj");
   std::ofstream out(path);
   for (int i = 0; i <= 40; ++i)
     for (int j = 0; j <= 40; ++j) out << "v " << i << " " << (i * j % 7) * 0.1 << " " << j << "\n";
@@ -78,7 +81,7 @@ TEST(Cli, EmbreeBuilderAndTable) {
 }
 
 TEST(Cli, BenchPrintsOneRowPerBuilder) {
-  const fs::path csv = fs::temp_directory_path() / "kmbvh-cli-bench.csv";
+  const fs::path csv = kmbvh::test::temp_path("bench.csv");
   const Result r = run("bench " + small_obj().string() + " --builders Q1,Q2,embree-medium --runs 1 --csv " +
                        csv.string());
   ASSERT_EQ(r.exit_code, 0) << r.err;
@@ -90,7 +93,7 @@ TEST(Cli, BenchPrintsOneRowPerBuilder) {
 }
 
 TEST(Cli, UnreadableFileExitsWithTwoAndNamesIt) {
-  const fs::path garbage = fs::temp_directory_path() / "kmbvh-cli-garbage.glb";
+  const fs::path garbage = kmbvh::test::temp_path("garbage.glb");
   std::ofstream(garbage, std::ios::binary) << "not a gltf file at all";
   for (const std::string& file : {garbage.string(), std::string("/nonexistent/scene.glb")}) {
     const Result r = run("build " + file + " -q");

@@ -10,17 +10,14 @@
 #include "adapters/in/default_scene.h"
 #include "adapters/in/load_scene.h"
 #include "support/printers.h"
+#include "support/temp_files.h"
 
 namespace kmbvh {
 namespace {
 
 namespace fs = std::filesystem;
 
-fs::path temp_file(const std::string& name) {
-  const fs::path dir = fs::temp_directory_path() / "kmbvh-tests";
-  fs::create_directories(dir);
-  return dir / name;
-}
+fs::path temp_file(const std::string& name) { return test::temp_path(name); }
 
 void write_text(const fs::path& path, const std::string& text) { std::ofstream(path) << text; }
 

@@ -8,6 +8,16 @@
 // representatives, run i Lloyd iterations (assign, update), assign once more, partition
 // each segment by cluster, and emit the children: leaves, treelet nodes and the next
 // level's segments.
+//
+// Two choices differ in form, not in result, from the paper's description:
+// - Nodes below m * k primitives are split with k = 2 in the same level loop as the others
+//   rather than after the main queue empties. A node's split depends only on its own
+//   primitives and its own random stream (node_stream), so the tree is the same; the loop
+//   just needs fewer levels.
+// - There is no separate bottom-up refit: every box is exact when it is written (cluster
+//   bounds come from the final assignment, treelet boxes are unions of those), which is
+//   what a refit would produce. validate() recomputes the boxes from the primitives and
+//   checks this on every tree. The finishing step is the breadth-first reorder.
 
 #include <thrust/copy.h>
 #include <thrust/count.h>
