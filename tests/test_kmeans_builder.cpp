@@ -52,16 +52,38 @@ TEST_P(EveryPreset, ValidOnRandomScenes) {
 
 TEST_P(EveryPreset, SameTreeWithOneAndTwoThreads) {
   const PrimitiveSet prims = make_primitive_set(test::clustered_triangles(30000, 3));
-  for (ClusterMetric metric : {ClusterMetric::Means, ClusterMetric::Medians}) {
-    KMeansParams params = *kmeans_preset(GetParam());
-    params.metric = metric;
-    set_thread_count(1);
-    const Bvh one = build_kmeans(prims, params);
-    set_thread_count(2);
-    const Bvh two = build_kmeans(prims, params);
-    set_thread_count(0);
-    EXPECT_TRUE(same_tree(one, two)) << to_string(metric);
-  }
+  for (ClusterMetric metric : {ClusterMetric::Means, ClusterMetric::Medians})
+    for (bool subtrees : {true, false}) {
+      KMeansParams params = *kmeans_preset(GetParam());
+      params.metric = metric;
+      params.cpu_subtrees = subtrees;
+      set_thread_count(1);
+      const Bvh one = build_kmeans(prims, params);
+      set_thread_count(2);
+      const Bvh two = build_kmeans(prims, params);
+      set_thread_count(0);
+      EXPECT_TRUE(same_tree(one, two)) << to_string(metric) << (subtrees ? " with" : " without") << " subtrees";
+    }
+}
+
+// The CPU subtree path (subtree_cpu.h) must build exactly the tree of the portable level
+// loop, which is what the GPU runs.
+TEST_P(EveryPreset, CpuSubtreePathBuildsTheLevelLoopsTree) {
+  const PrimitiveSet clustered = make_primitive_set(test::clustered_triangles(30000, 4));
+  const PrimitiveSet identical = make_primitive_set(test::identical_triangles(5000));
+  for (const PrimitiveSet* prims : {&clustered, &identical})
+    for (ClusterMetric metric : {ClusterMetric::Means, ClusterMetric::Medians})
+      for (bool wide : {false, true}) {
+        KMeansParams params = *kmeans_preset(GetParam());
+        params.metric = metric;
+        params.wide = wide;
+        BuildInfo with_info, without_info;
+        const Bvh with = build_kmeans(*prims, params, Backend::Cpu, &with_info);
+        params.cpu_subtrees = false;
+        const Bvh without = build_kmeans(*prims, params, Backend::Cpu, &without_info);
+        EXPECT_TRUE(same_tree(with, without)) << to_string(metric) << (wide ? " wide" : "");
+        EXPECT_EQ(with_info.forced_splits, without_info.forced_splits);
+      }
 }
 
 INSTANTIATE_TEST_SUITE_P(KMeans, EveryPreset, ::testing::Values("Q1", "Q2", "Q3", "Q4", "Q5"));
@@ -92,15 +114,29 @@ TEST(KMeansBuilder, SeedChangesTreeButNotValidity) {
   EXPECT_FALSE(same_tree(build_kmeans(prims, a), build_kmeans(prims, b)));
 }
 
-TEST(KMeansBuilder, ReportsPhasesAndLevels) {
-  const PrimitiveSet prims = make_primitive_set(test::random_triangles(5000, 6));
-  BuildInfo info;
-  build_kmeans(prims, *kmeans_preset("Q2"), Backend::Cpu, &info);
-  EXPECT_GT(info.levels, 2u);
+std::vector<std::string> phase_names(const BuildInfo& info) {
   std::vector<std::string> names;
   for (const auto& [name, ms] : info.phase_ms) names.push_back(name);
+  return names;
+}
+
+TEST(KMeansBuilder, ReportsPhasesAndLevels) {
+  const PrimitiveSet prims = make_primitive_set(test::random_triangles(5000, 6));
+  KMeansParams params = *kmeans_preset("Q2");
+  params.cpu_subtrees = false;  // every level through the level loop: the paper's phases
+  BuildInfo levels;
+  build_kmeans(prims, params, Backend::Cpu, &levels);
+  EXPECT_GT(levels.levels, 2u);
+  const auto names = phase_names(levels);
   for (const char* phase : {"initialise", "assign", "update", "partition", "agglomerate", "finish"})
     EXPECT_NE(std::find(names.begin(), names.end(), phase), names.end()) << phase;
+
+  params.cpu_subtrees = true;  // the root (more than one piece) in the level loop, the rest as subtrees
+  BuildInfo subtrees;
+  build_kmeans(prims, params, Backend::Cpu, &subtrees);
+  EXPECT_EQ(subtrees.levels, 1u);
+  const auto with = phase_names(subtrees);
+  EXPECT_NE(std::find(with.begin(), with.end(), "subtrees"), with.end());
 }
 
 TEST(KMeansBuilder, RejectsBadParameters) {

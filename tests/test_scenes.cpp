@@ -39,6 +39,7 @@ TEST_P(EveryScene, TreeIsValid) {
   BuilderConfig config = parse_builder(spec.substr(0, spec.find('+')));
   if (spec.find("+medians") != std::string::npos) config.kmeans.metric = ClusterMetric::Medians;
   if (spec.find("+wide") != std::string::npos) config.kmeans.wide = true;
+  if (spec.find("+levels") != std::string::npos) config.kmeans.cpu_subtrees = false;  // the GPU's path
   for (const std::string& file : files) {
     const PrimitiveSet& prims = scene_prims(file);
     const Bvh bvh = run_builder(config, prims);
@@ -48,7 +49,7 @@ TEST_P(EveryScene, TreeIsValid) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, EveryScene,
-                         ::testing::Values("Q1", "Q2", "Q3", "Q4", "Q5", "Q2+medians", "Q3+wide", "embree-low",
+                         ::testing::Values("Q1", "Q2", "Q3", "Q4", "Q5", "Q2+medians", "Q3+wide", "Q2+levels", "embree-low",
                                            "embree-medium", "embree-high"),
                          [](const auto& info) {
                            std::string name = info.param;

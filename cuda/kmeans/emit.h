@@ -53,6 +53,64 @@ struct CountChildren {
   }
 };
 
+// Writes the children of k-ary node `parent`: the j non-empty clusters (boxes and
+// primitive counts given) either directly (wide) or under a binary agglomerative treelet,
+// in the slots from first_node on (j of them, or 2j - 2). For each cluster t, calls
+// on_cluster(t, slot); the caller writes that node. Shared by the level loop and the CPU
+// subtree path, so both lay trees out the same way.
+template <uint32_t KMax, typename OnCluster>
+KMBVH_HD void lay_out_children(BvhNode* nodes, uint32_t parent, uint32_t first_node, const Aabb* box,
+                               const uint32_t* weight, uint32_t j, bool wide, OnCluster&& on_cluster) {
+  auto set_children = [&](uint32_t node, uint32_t first, uint32_t count) {
+    nodes[node].first = first;
+    nodes[node].count = static_cast<uint16_t>(count);
+    nodes[node].leaf = 0;
+  };
+  if (wide) {
+    set_children(parent, first_node, j);
+    for (uint32_t t = 0; t < j; ++t) on_cluster(t, first_node + t);
+    return;
+  }
+  TreeletMerges<KMax> merges;
+  agglomerate(box, weight, j, merges);
+  // Breadth-first: the q-th inner node visited gets the pair of slots first_node + 2q and
+  // first_node + 2q + 1 for its children. The treelet's root is the parent itself.
+  uint32_t node_of_merge[KMax];
+  uint32_t queue[KMax];
+  uint32_t head = 0, tail = 0;
+  queue[tail++] = j - 2;
+  node_of_merge[j - 2] = parent;
+  while (head < tail) {
+    const uint32_t m = queue[head];
+    const uint32_t pair = first_node + 2 * head;
+    ++head;
+    set_children(node_of_merge[m], pair, 2);
+    const uint32_t sides[2] = {merges.left[m], merges.right[m]};
+    for (uint32_t side = 0; side < 2; ++side) {
+      const uint32_t ref = sides[side];
+      if (ref < j) {
+        on_cluster(ref, pair + side);
+      } else {
+        node_of_merge[ref - j] = pair + side;
+        nodes[pair + side] = BvhNode::make_interior(merges.box[ref - j], 0, 0);
+        queue[tail++] = ref - j;
+      }
+    }
+  }
+}
+
+// A cluster's node: a leaf when it is small enough, else an interior node whose children a
+// later split attaches. Returns true in the second case.
+KMBVH_HD KMBVH_INLINE bool write_cluster_node(BvhNode& node, const Aabb& box, uint32_t begin, uint32_t count,
+                                              uint32_t max_leaf_size) {
+  if (count <= max_leaf_size) {
+    node = BvhNode::make_leaf(box, begin, count);
+    return false;
+  }
+  node = BvhNode::make_interior(box, 0, 0);
+  return true;
+}
+
 template <uint32_t KMax>
 struct EmitChildren {
   const Segment* segments;
@@ -76,67 +134,20 @@ struct EmitChildren {
       box[j] = clusters.bounds[slot].to_aabb();
       ++j;
     }
-    const uint32_t first_node = node_base + offsets[s].nodes;
-    uint32_t next_segment = offsets[s].segments;
-
-    if (rules.wide) {
-      set_children(seg.node, first_node, j);
-      for (uint32_t t = 0; t < j; ++t) emit_cluster(cluster[t], box[t], first_node + t, next_segment);
-      return;
-    }
-
-    TreeletMerges<KMax> merges;
-    agglomerate(box, weight, j, merges);
-    // Lay the treelet out breadth-first: the q-th inner node visited gets the pair of slots
-    // first_node + 2q, + 2q + 1 for its children. The root is the segment's own node.
-    uint32_t node_of_merge[KMax];
-    uint32_t queue[KMax];
-    uint32_t head = 0, tail = 0;
-    queue[tail++] = j - 2;
-    node_of_merge[j - 2] = seg.node;
-    while (head < tail) {
-      const uint32_t m = queue[head];
-      const uint32_t pair = first_node + 2 * head;
-      ++head;
-      set_children(node_of_merge[m], pair, 2);
-      const uint32_t sides[2] = {merges.left[m], merges.right[m]};
-      for (uint32_t side = 0; side < 2; ++side) {
-        const uint32_t ref = sides[side];
-        if (ref < j) {
-          emit_cluster(cluster[ref], box[ref], pair + side, next_segment);
-        } else {
-          const uint32_t child = ref - j;
-          node_of_merge[child] = pair + side;
-          nodes[pair + side] = BvhNode::make_interior(merges.box[child], 0, 0);
-          queue[tail++] = child;
-        }
-      }
-    }
-  }
-
- private:
-  KMBVH_HD void set_children(uint32_t node, uint32_t first, uint32_t count) const {
-    nodes[node].first = first;
-    nodes[node].count = static_cast<uint16_t>(count);
-    nodes[node].leaf = 0;
-  }
-
-  KMBVH_HD void emit_cluster(uint32_t slot, const Aabb& box, uint32_t node, uint32_t& next_segment) const {
-    const uint32_t count = clusters.counts[slot];
-    const uint32_t begin = clusters.begin[slot];
-    if (count <= rules.max_leaf_size) {
-      nodes[node] = BvhNode::make_leaf(box, begin, count);
-      return;
-    }
-    // An interior node whose children the next level will attach.
-    nodes[node] = BvhNode::make_interior(box, 0, 0);
-    Segment child;
-    child.begin = begin;
-    child.count = count;
-    child.node = node;
-    child.k = rules.child_k(count);
-    child.box = box;
-    next_segments[next_segment++] = child;
+    uint32_t next = offsets[s].segments;
+    lay_out_children<KMax>(nodes, seg.node, node_base + offsets[s].nodes, box, weight, j, rules.wide,
+                           [&](uint32_t t, uint32_t node) {
+                             const uint32_t begin = clusters.begin[cluster[t]];
+                             if (!write_cluster_node(nodes[node], box[t], begin, weight[t], rules.max_leaf_size))
+                               return;
+                             Segment child;
+                             child.begin = begin;
+                             child.count = weight[t];
+                             child.node = node;
+                             child.k = rules.child_k(weight[t]);
+                             child.box = box[t];
+                             next_segments[next++] = child;
+                           });
   }
 };
 

@@ -20,6 +20,7 @@
 //   checks this on every tree. The finishing step is the breadth-first reorder.
 
 #include <thrust/copy.h>
+#include <thrust/device_allocator.h>
 #include <thrust/count.h>
 #include <thrust/device_vector.h>
 #include <thrust/execution_policy.h>
@@ -48,11 +49,28 @@
 #error "define KMBVH_BACKEND_NAMESPACE and KMBVH_PIECE_SIZE before including kmeans_builder.inl"
 #endif
 
+// The CPU backend finishes one-piece nodes with the hand-written subtree path.
+#if KMBVH_CPU_SUBTREES
+#include "subtree_cpu.h"
+#endif
+
 namespace kmbvh {
 namespace KMBVH_BACKEND_NAMESPACE {
 
+// Working buffers are not value-initialised: every kernel writes what it later reads
+// (the cluster accumulators are cleared explicitly per pass), so filling fresh memory with
+// zeros would only cost time. This is Thrust's own uninitialized_allocator idiom.
 template <typename T>
-using Buffer = thrust::device_vector<T>;
+struct UninitializedAllocator : thrust::device_allocator<T> {
+  template <typename U>
+  struct rebind {
+    using other = UninitializedAllocator<U>;
+  };
+  KMBVH_HD void construct(T*) {}
+};
+
+template <typename T>
+using Buffer = thrust::device_vector<T, UninitializedAllocator<T>>;
 
 template <typename T>
 T* ptr(Buffer<T>& b) {
@@ -123,6 +141,9 @@ class KMeansLevels {
     clock_.lap("setup");
 
     while (segment_count > 0) {
+#if KMBVH_CPU_SUBTREES
+      if (params_.cpu_subtrees && (segment_count = split_subtrees(segment_count)) == 0) break;
+#endif
       if (info_) ++info_->levels;
       segment_count = split_level(segment_count);
       current_ = 1 - current_;
@@ -241,6 +262,68 @@ class KMeansLevels {
     return total.segments;
   }
 
+#if KMBVH_CPU_SUBTREES
+  // Takes the segments of one piece or less out of the level, and splits each one's whole
+  // subtree in one work item (subtree_cpu.h); returns how many segments remain. The
+  // backend's arrays are host memory here, so they are used directly.
+  uint32_t split_subtrees(uint32_t segment_count) {
+    Segment* segments = ptr(segments_);
+    std::vector<Segment> small;
+    uint32_t kept = 0;
+    for (uint32_t s = 0; s < segment_count; ++s) {
+      if (segments[s].count <= KMBVH_PIECE_SIZE)
+        small.push_back(segments[s]);
+      else
+        segments[kept++] = segments[s];
+    }
+    if (small.empty()) return kept;
+    std::vector<SubtreeNodes> done(small.size());
+    Aabb* boxes = ptr(boxes_[current_]);
+    uint32_t* ids = ptr(ids_[current_]);
+    uint32_t* final_ids = ptr(final_ids_);
+    uint32_t forced = 0;
+#pragma omp parallel reduction(+ : forced)
+    {
+      SubtreeSplitter<KMax, M> splitter(params_);
+#pragma omp for schedule(dynamic, 1)
+      for (int64_t t = 0; t < int64_t(small.size()); ++t)
+        done[t] = splitter.split(small[t], boxes, ids, final_ids, forced);
+    }
+    for (SubtreeNodes& d : done) subtrees_.push_back(std::move(d));
+    if (info_) info_->forced_splits += forced;
+    clock_.lap("subtrees");
+    return kept;
+  }
+
+  // Appends the subtrees' nodes after the level loop's, renumbered: a subtree's node 0 is
+  // its segment's node, and its node i > 0 lands at offset + i - 1.
+  void append_subtrees(std::vector<BvhNode>& nodes) {
+    std::vector<uint32_t> offset(subtrees_.size());
+    size_t total = node_count_;
+    for (size_t t = 0; t < subtrees_.size(); ++t) {
+      offset[t] = static_cast<uint32_t>(total);
+      total += subtrees_[t].nodes.size() - 1;
+    }
+    nodes.resize(total);
+#pragma omp parallel for schedule(dynamic, 16)
+    for (int64_t t = 0; t < int64_t(subtrees_.size()); ++t) {
+      const SubtreeNodes& sub = subtrees_[t];
+      auto renumber = [&](BvhNode n) {
+        if (!n.is_leaf()) n.first = offset[t] + n.first - 1;  // children are never local node 0
+        return n;
+      };
+      const BvhNode root = renumber(sub.nodes[0]);
+      nodes[sub.root].first = root.first;
+      nodes[sub.root].count = root.count;
+      nodes[sub.root].leaf = root.leaf;
+      for (size_t i = 1; i < sub.nodes.size(); ++i) nodes[offset[t] + i - 1] = renumber(sub.nodes[i]);
+    }
+    std::vector<SubtreeNodes>().swap(subtrees_);
+  }
+
+  std::vector<SubtreeNodes> subtrees_;
+#endif
+
   // Copies the tree out, freeing each working buffer as soon as it is done with, so that
   // the finishing step does not raise the build's peak memory.
   Bvh finish() {
@@ -251,6 +334,9 @@ class KMeansLevels {
     raw.nodes.resize(node_count_);
     thrust::copy(nodes_.begin(), nodes_.begin() + node_count_, raw.nodes.begin());
     release(nodes_);
+#if KMBVH_CPU_SUBTREES
+    append_subtrees(raw.nodes);
+#endif
     raw.prim_indices.resize(n_);
     thrust::copy(final_ids_.begin(), final_ids_.end(), raw.prim_indices.begin());
     release(final_ids_);

@@ -20,6 +20,10 @@ struct KMeansParams {
   uint32_t seed = 1;
   ClusterMetric metric = ClusterMetric::Means;
   bool wide = false;           // emit the k-ary tree directly instead of binary treelets
+  // CPU backend: finish each node of at most one piece (2048 primitives) in one work item,
+  // depth-first (subtree_cpu.h). The tree is the same either way; false runs every level
+  // through the portable level loop, as the GPU does.
+  bool cpu_subtrees = true;
 
   static constexpr uint32_t kMaxK = 64;  // local arrays in the kernels are sized by this
 };

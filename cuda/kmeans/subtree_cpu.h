@@ -1,0 +1,206 @@
+// A hand-written CPU path for the bottom of the tree (DESIGN.md §3: where a CPU path is
+// measurably faster than the generic one, keep both). Once a node holds at most one piece
+// of primitives, the level loop would still stream the whole level's arrays through every
+// pass for it; here one work item splits the node's entire subtree depth-first instead,
+// while its primitives stay in cache, with a dynamic schedule across nodes.
+//
+// It runs the same steps as the level loop (initialise.h, assign.h, update_means.h,
+// update_medians.h, partition's stable counting sort and guaranteed split, emit.h's
+// lay_out_children), on the same random streams (keyed by primitive range, not by node
+// number), and a node of one piece has exactly one fixed-point sum per cluster either way.
+// The finished tree, reordered breadth-first, is therefore the same bit for bit; the tests
+// build every preset both ways and compare.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "../core/bvh.h"
+#include "assign.h"
+#include "emit.h"
+#include "initialise.h"
+#include "level.h"
+#include "params.h"
+#include "update_means.h"
+#include "update_medians.h"
+
+namespace kmbvh {
+
+// Nodes made by one work item, numbered locally: node 0 stands for the subtree's root
+// (its segment's node in the level loop's array), the others are new.
+struct SubtreeNodes {
+  uint32_t root = 0;  // the segment's node in the level loop's array
+  std::vector<BvhNode> nodes;
+};
+
+template <uint32_t KMax, ClusterMetric M>
+class SubtreeSplitter {
+ public:
+  explicit SubtreeSplitter(const KMeansParams& params) : params_(params) {}
+
+  // Splits everything under `root`, reordering its range of boxes and ids in place and
+  // writing the output order of its primitives into final_ids.
+  SubtreeNodes split(const Segment& root, Aabb* boxes, uint32_t* ids, uint32_t* final_ids, uint32_t& forced_splits) {
+    SubtreeNodes out;
+    out.root = root.node;
+    out.nodes.push_back(BvhNode::make_interior(root.box, 0, 0));
+    scratch_boxes_.resize(root.count);
+    scratch_ids_.resize(root.count);
+    cluster_of_.resize(root.count);
+    pending_.clear();
+    pending_.push_back({root.begin, root.count, 0, root.k, root.box});
+    while (!pending_.empty()) {
+      const Pending p = pending_.back();
+      pending_.pop_back();
+      forced_splits += split_node(p, boxes + p.begin, ids + p.begin, final_ids + p.begin, out.nodes);
+    }
+    return out;
+  }
+
+ private:
+  struct Pending {
+    uint32_t begin, count, node, k;
+    Aabb box;
+  };
+
+  // Returns 1 when the node had to be split by position (the guaranteed split).
+  uint32_t split_node(const Pending& p, Aabb* boxes, uint32_t* ids, uint32_t* final_ids, std::vector<BvhNode>& nodes) {
+    const uint32_t k = p.k;
+    Aabb reps[KMax];
+    initialise_representatives<M>(boxes, p.count, k, params_.p, params_.seed, node_stream(p.begin, p.count), reps);
+    for (uint32_t iteration = 0; iteration < params_.i; ++iteration) update(p, boxes, reps);
+
+    // The final assignment, with the guaranteed split when it leaves one cluster.
+    uint32_t count[KMax];
+    Aabb bounds[KMax];
+    assign_final(boxes, p.count, k, reps, count, bounds);
+    uint32_t non_empty = 0;
+    for (uint32_t c = 0; c < k; ++c) non_empty += count[c] != 0;
+    const bool forced = non_empty < 2;
+    if (forced) {
+      for (uint32_t c = 0; c < k; ++c) {
+        count[c] = 0;
+        bounds[c] = Aabb::empty();
+      }
+      for (uint32_t x = 0; x < p.count; ++x) {
+        const uint32_t c = static_cast<uint32_t>((uint64_t(x) * k) / p.count);
+        cluster_of_[x] = static_cast<uint8_t>(c);
+        ++count[c];
+        bounds[c].grow(boxes[x]);
+      }
+    }
+
+    uint32_t begin[KMax];
+    partition(boxes, ids, p.count, k, count, begin, /*gather_only=*/false);
+    for (uint32_t x = 0; x < p.count; ++x) final_ids[x] = ids[x];
+
+    // Children: the same layout as the level loop's EmitChildren.
+    uint32_t weight[KMax], first[KMax];
+    Aabb box[KMax];
+    uint32_t j = 0;
+    for (uint32_t c = 0; c < k; ++c) {
+      if (count[c] == 0) continue;
+      weight[j] = count[c];
+      first[j] = p.begin + begin[c];
+      box[j] = bounds[c];
+      ++j;
+    }
+    const EmitRules rules{params_.max_leaf_size, params_.k, params_.wide};
+    const auto first_node = static_cast<uint32_t>(nodes.size());
+    nodes.resize(nodes.size() + (rules.wide ? j : 2 * j - 2));
+    lay_out_children<KMax>(nodes.data(), p.node, first_node, box, weight, j, rules.wide, [&](uint32_t t, uint32_t node) {
+      if (write_cluster_node(nodes[node], box[t], first[t], weight[t], rules.max_leaf_size))
+        pending_.push_back({first[t], weight[t], node, rules.child_k(weight[t]), box[t]});
+    });
+    return forced ? 1u : 0u;
+  }
+
+  // One Lloyd iteration after an assignment: the mean (fixed point, as one piece of the
+  // level loop publishes it) or the component-wise median.
+  void update(const Pending& p, Aabb* boxes, Aabb* reps) {
+    RepresentativeTable<KMax, M> table;
+    table.load(reps, p.k);
+    uint32_t count[KMax];
+    for (uint32_t c = 0; c < p.k; ++c) count[c] = 0;
+    if constexpr (M == ClusterMetric::Means) {
+      SumAccumulator<KMax> acc;
+      acc.clear(p.k);
+      for (uint32_t x = 0; x < p.count; ++x) {
+        const uint32_t c = table.nearest(boxes[x]);
+        ++count[c];
+        acc.add(c, boxes[x]);
+      }
+      const FixedPointFrame frame = FixedPointFrame::of(p.box);
+      for (uint32_t c = 0; c < p.k; ++c) {
+        if (count[c] == 0) continue;
+        ClusterSums sums;
+        acc.publish(c, count[c], frame, /*sole=*/true, sums);
+        for (int d = 0; d < 3; ++d) {
+          reps[c].lo[d] = frame.decode_mean(sums.s[d], count[c], d);
+          reps[c].hi[d] = frame.decode_mean(sums.s[3 + d], count[c], d);
+        }
+      }
+    } else {
+      for (uint32_t x = 0; x < p.count; ++x) {
+        const uint32_t c = table.nearest(boxes[x]);
+        cluster_of_[x] = static_cast<uint8_t>(c);
+        ++count[c];
+      }
+      uint32_t begin[KMax];
+      partition(boxes, nullptr, p.count, p.k, count, begin, /*gather_only=*/true);
+      for (uint32_t c = 0; c < p.k; ++c) {
+        if (count[c] == 0) continue;
+        Aabb* members = scratch_boxes_.data() + begin[c];
+        const uint32_t rank = (count[c] - 1) / 2;
+        for (int d = 0; d < 3; ++d) {
+          reps[c].lo[d] = select_component(members, count[c], d, rank);
+          reps[c].hi[d] = select_component(members, count[c], 3 + d, rank);
+        }
+      }
+    }
+  }
+
+  void assign_final(const Aabb* boxes, uint32_t n, uint32_t k, const Aabb* reps, uint32_t* count, Aabb* bounds) {
+    RepresentativeTable<KMax, M> table;
+    table.load(reps, k);
+    for (uint32_t c = 0; c < k; ++c) {
+      count[c] = 0;
+      bounds[c] = Aabb::empty();
+    }
+    for (uint32_t x = 0; x < n; ++x) {
+      const uint32_t c = table.nearest(boxes[x]);
+      cluster_of_[x] = static_cast<uint8_t>(c);
+      ++count[c];
+      bounds[c].grow(boxes[x]);
+    }
+  }
+
+  // Stable counting sort by cluster. gather_only: the boxes go to the scratch buffer and
+  // stay there (the median update selects on them); otherwise boxes and ids are reordered
+  // in place. begin[c]: where cluster c starts, relative to the node.
+  void partition(Aabb* boxes, uint32_t* ids, uint32_t n, uint32_t k, const uint32_t* count, uint32_t* begin,
+                 bool gather_only) {
+    uint32_t cursor[KMax];
+    uint32_t at = 0;
+    for (uint32_t c = 0; c < k; ++c) {
+      begin[c] = cursor[c] = at;
+      at += count[c];
+    }
+    for (uint32_t x = 0; x < n; ++x) {
+      const uint32_t to = cursor[cluster_of_[x]]++;
+      scratch_boxes_[to] = boxes[x];
+      if (!gather_only) scratch_ids_[to] = ids[x];
+    }
+    if (gather_only) return;
+    std::copy(scratch_boxes_.begin(), scratch_boxes_.begin() + n, boxes);
+    std::copy(scratch_ids_.begin(), scratch_ids_.begin() + n, ids);
+  }
+
+  const KMeansParams& params_;
+  std::vector<Aabb> scratch_boxes_;
+  std::vector<uint32_t> scratch_ids_;
+  std::vector<uint8_t> cluster_of_;
+  std::vector<Pending> pending_;
+};
+
+}  // namespace kmbvh
