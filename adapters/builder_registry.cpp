@@ -4,11 +4,16 @@
 
 #include <stdexcept>
 
+#include "cuda/sweep_sah/sweep_sah.h"
 #include "embree/embree_builder.h"
 #include "embree/embree_device.h"
 
 namespace kmbvh {
 namespace {
+
+bool is_binary(const std::string& name) {
+  return name == "lbvh" || name == "hlbvh" || name == "atrbvh" || name == "ploc";
+}
 
 bool is_embree(const std::string& name, EmbreeQuality* quality) {
   if (name == "embree-low") *quality = EmbreeQuality::Low;
@@ -21,6 +26,12 @@ bool is_embree(const std::string& name, EmbreeQuality* quality) {
 }  // namespace
 
 std::string BuilderConfig::label() const {
+  const BinaryBuildParams defaults;
+  if (builder == "ploc" && binary.ploc_radius != defaults.ploc_radius)
+    return fmt::format("ploc r={}", binary.ploc_radius);
+  if (builder == "atrbvh" &&
+      (binary.treelet_size != defaults.treelet_size || binary.treelet_iterations != defaults.treelet_iterations))
+    return fmt::format("atrbvh t={} i={}", binary.treelet_size, binary.treelet_iterations);
   if (builder != "kmeans") return builder;
   const std::string medians = kmeans.metric == ClusterMetric::Medians ? " medians" : "";
   const std::string wide = kmeans.wide ? " wide" : "";
@@ -29,7 +40,8 @@ std::string BuilderConfig::label() const {
 }
 
 const std::vector<std::string>& builder_names() {
-  static const std::vector<std::string> names{"kmeans", "embree-low", "embree-medium", "embree-high"};
+  static const std::vector<std::string> names{"sweep-sah", "lbvh",       "hlbvh",         "atrbvh",     "ploc",
+                                              "kmeans",    "embree-low", "embree-medium", "embree-high"};
   return names;
 }
 
@@ -51,11 +63,19 @@ BuilderConfig parse_builder(const std::string& spec) {
     config.kmeans = *params;
     config.preset = preset;
     for (char& c : config.preset) c = char(std::toupper(static_cast<unsigned char>(c)));
-  } else if (!is_embree(name, &quality)) {
-    throw std::invalid_argument(
-        fmt::format("unknown builder '{}' (kmeans, Q1..Q5, embree-low, embree-medium, embree-high)", spec));
+  } else if (!is_embree(name, &quality) && !is_binary(name) && name != "sweep-sah") {
+    throw std::invalid_argument(fmt::format(
+        "unknown builder '{}' (sweep-sah, lbvh, hlbvh, atrbvh, ploc, kmeans, Q1..Q5, embree-low|medium|high)", spec));
   }
   return config;
+}
+
+std::vector<BuilderConfig> all_builders() {
+  std::vector<BuilderConfig> all;
+  for (const char* spec : {"sweep-sah", "lbvh", "hlbvh", "atrbvh", "ploc", "Q1", "Q2", "Q3", "Q4", "Q5", "embree-low",
+                           "embree-medium", "embree-high"})
+    all.push_back(parse_builder(spec));
+  return all;
 }
 
 void prepare_builder(const BuilderConfig& config) {
@@ -69,6 +89,19 @@ Bvh run_builder(const BuilderConfig& config, const PrimitiveSet& prims, BuildInf
     KMeansParams params = config.kmeans;
     params.max_leaf_size = config.max_leaf_size;
     return build_kmeans(prims, params, config.backend, info);
+  }
+  if (is_binary(config.builder)) {
+    BinaryBuildParams params = config.binary;
+    params.max_leaf_size = config.max_leaf_size;
+    if (config.builder == "lbvh") return build_lbvh(prims, params, config.backend, info);
+    if (config.builder == "hlbvh") return build_hlbvh(prims, params, config.backend, info);
+    if (config.builder == "atrbvh") return build_atrbvh(prims, params, config.backend, info);
+    return build_ploc(prims, params, config.backend, info);
+  }
+  if (config.builder == "sweep-sah") {
+    SweepSahParams params;
+    params.max_leaf_size = config.max_leaf_size;
+    return build_sweep_sah(prims, params, info);
   }
   if (is_embree(config.builder, &quality)) {
     EmbreeBuildOptions options;

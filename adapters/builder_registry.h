@@ -8,6 +8,7 @@
 
 #include "cuda/core/build_info.h"
 #include "cuda/core/bvh.h"
+#include "cuda/binary/binary_builders.h"
 #include "cuda/core/primitive_set.h"
 #include "cuda/kmeans/kmeans_builder.h"
 #include "cuda/metrics/validate.h"
@@ -18,10 +19,11 @@ struct BuilderConfig {
   std::string builder = "kmeans";  // one of builder_names()
   KMeansParams kmeans;             // for "kmeans"
   std::string preset;              // the preset kmeans was set from ("Q2"), or empty
-  Backend backend = Backend::Cpu;  // for "kmeans"
+  BinaryBuildParams binary;        // for "lbvh", "hlbvh", "atrbvh", "ploc" (their own parameters)
+  Backend backend = Backend::Cpu;  // for the portable builders (kmeans and the binary ones)
   uint32_t max_leaf_size = 8;      // for every builder
 
-  // "kmeans Q2", "kmeans k=16 p=5 i=5 medians", "embree-medium".
+  // "kmeans Q2", "kmeans k=16 p=5 i=5 medians", "ploc", "ploc r=8", "embree-medium".
   std::string label() const;
 };
 
@@ -30,6 +32,10 @@ const std::vector<std::string>& builder_names();
 // "kmeans" with the preset, "kmeans:Q3", "Q3" (shorthand), or any other builder name.
 // Throws std::invalid_argument naming what is unknown.
 BuilderConfig parse_builder(const std::string& spec);
+
+// Every builder, as `kmbvh bench --builders all` runs them: the references first, then
+// k-means Q1-Q5, then Embree's.
+std::vector<BuilderConfig> all_builders();
 
 // Sets up what the builder needs once per process (Embree's device), so that the first
 // measured build is not charged for it.

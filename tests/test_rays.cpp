@@ -32,7 +32,8 @@ void expect_same_hits(const TriangleScene& scene, const BuilderConfig& config, u
 
 std::vector<BuilderConfig> configs() {
   std::vector<BuilderConfig> all;
-  for (const char* spec : {"Q1", "Q3", "Q5", "embree-low", "embree-medium"}) all.push_back(parse_builder(spec));
+  for (const char* spec : {"sweep-sah", "lbvh", "hlbvh", "atrbvh", "ploc", "Q1", "Q3", "Q5", "embree-low", "embree-medium"})
+    all.push_back(parse_builder(spec));
   BuilderConfig medians = parse_builder("Q2");
   medians.kmeans.metric = ClusterMetric::Medians;
   all.push_back(medians);

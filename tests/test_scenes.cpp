@@ -49,7 +49,8 @@ TEST_P(EveryScene, TreeIsValid) {
 }
 
 INSTANTIATE_TEST_SUITE_P(Scenes, EveryScene,
-                         ::testing::Values("Q1", "Q2", "Q3", "Q4", "Q5", "Q2+medians", "Q3+wide", "Q2+levels", "embree-low",
+                         ::testing::Values("sweep-sah", "lbvh", "hlbvh", "atrbvh", "ploc", "Q1", "Q2", "Q3", "Q4", "Q5",
+                                           "Q2+medians", "Q3+wide", "Q2+levels", "embree-low",
                                            "embree-medium", "embree-high"),
                          [](const auto& info) {
                            std::string name = info.param;

@@ -45,6 +45,50 @@ KMBVH_HD KMBVH_INLINE void atomic_max(uint32_t* p, uint32_t v) {
 #endif
 }
 
+// Counts an arrival at a meeting point shared by several work items, and orders memory
+// around it: whatever the earlier arrivals wrote before arriving is visible to the later
+// ones after (acquire-release). Returns the number of earlier arrivals.
+KMBVH_HD KMBVH_INLINE uint32_t arrive(uint32_t* counter) {
+#if KMBVH_DEVICE_CODE
+  __threadfence();
+  const uint32_t before = atomicAdd(counter, 1u);
+  __threadfence();
+  return before;
+#else
+  return __atomic_fetch_add(counter, 1u, __ATOMIC_ACQ_REL);
+#endif
+}
+
+// Stores v and returns what was there, with the same ordering as arrive(): the value read
+// comes from a work item whose earlier writes are now visible, and this one's earlier
+// writes become visible to whoever reads v.
+KMBVH_HD KMBVH_INLINE uint32_t exchange(uint32_t* p, uint32_t v) {
+#if KMBVH_DEVICE_CODE
+  __threadfence();
+  const uint32_t before = atomicExch(p, v);
+  __threadfence();
+  return before;
+#else
+  return __atomic_exchange_n(p, v, __ATOMIC_ACQ_REL);
+#endif
+}
+
+// Reads data another work item wrote before an arrive() or exchange(): on the device, around the
+// non-coherent L1 cache (volatile 32-bit loads); on the host, a plain load.
+template <typename T>
+KMBVH_HD KMBVH_INLINE T coherent_load(const T* p) {
+#if KMBVH_DEVICE_CODE
+  static_assert(sizeof(T) % 4 == 0, "coherent_load reads 32-bit words");
+  T value;
+  const volatile uint32_t* from = reinterpret_cast<const volatile uint32_t*>(p);
+  uint32_t* to = reinterpret_cast<uint32_t*>(&value);
+  for (size_t w = 0; w < sizeof(T) / 4; ++w) to[w] = from[w];
+  return value;
+#else
+  return *p;
+#endif
+}
+
 // Floats mapped to unsigned integers whose order is the floats' order, so that float
 // min/max can use integer atomics (and are exact and order-independent).
 KMBVH_HD KMBVH_INLINE uint32_t float_to_ordered(float f) {

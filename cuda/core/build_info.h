@@ -12,7 +12,9 @@ namespace kmbvh {
 struct BuildInfo {
   std::vector<std::pair<std::string, double>> phase_ms;  // in the order the phases first ran
   uint32_t levels = 0;          // top-down levels (k-means)
-  uint32_t forced_splits = 0;   // nodes split by position because clustering could not split them
+  // Steps taken by position because clustering made no progress: k-means nodes split by
+  // index, PLOC iterations that paired Morton neighbours.
+  uint32_t forced_splits = 0;
   // Time inside the builder call spent only to hand its result to kmbvh's measuring (for
   // Embree: refilling its input array and converting its nodes into a Bvh). Reported build
   // times leave it out, so each builder is charged what an application using it pays.

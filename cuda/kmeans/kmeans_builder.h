@@ -5,19 +5,13 @@
 // GPU: the same kernel bodies either way.
 #pragma once
 
+#include "../core/backend.h"
 #include "../core/build_info.h"
 #include "../core/bvh.h"
 #include "../core/primitive_set.h"
 #include "params.h"
 
 namespace kmbvh {
-
-enum class Backend { Cpu, Cuda };
-
-const char* to_string(Backend backend);
-bool cuda_backend_compiled();
-// True when the CUDA backend is compiled in and a CUDA device can be used.
-bool cuda_device_available();
 
 // Throws std::invalid_argument for parameters check_params() rejects, and
 // std::runtime_error when the backend cannot run (no CUDA device).
@@ -27,10 +21,7 @@ Bvh build_kmeans(const PrimitiveSet& prims, const KMeansParams& params, Backend 
 
 namespace detail {
 Bvh build_kmeans_cpu(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info);
-#if defined(KMBVH_HAS_CUDA)
 Bvh build_kmeans_gpu(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info);
-bool cuda_device_present();
-#endif
 }  // namespace detail
 
 }  // namespace kmbvh

@@ -19,22 +19,15 @@
 //   what a refit would produce. validate() recomputes the boxes from the primitives and
 //   checks this on every tree. The finishing step is the breadth-first reorder.
 
-#include <thrust/copy.h>
-#include <thrust/device_allocator.h>
 #include <thrust/count.h>
-#include <thrust/device_vector.h>
-#include <thrust/execution_policy.h>
 #include <thrust/fill.h>
-#include <thrust/for_each.h>
-#include <thrust/iterator/counting_iterator.h>
-#include <thrust/reduce.h>
 #include <thrust/scan.h>
 #include <thrust/sequence.h>
 #include <thrust/transform_scan.h>
 
-#include <chrono>
 #include <utility>
 
+#include "../core/portable.h"
 #include "../core/breadth_first.h"
 #include "agglomerate.h"
 #include "assign.h"
@@ -45,8 +38,8 @@
 #include "update_means.h"
 #include "update_medians.h"
 
-#if !defined(KMBVH_BACKEND_NAMESPACE) || !defined(KMBVH_PIECE_SIZE)
-#error "define KMBVH_BACKEND_NAMESPACE and KMBVH_PIECE_SIZE before including kmeans_builder.inl"
+#if !defined(KMBVH_PIECE_SIZE)
+#error "define KMBVH_PIECE_SIZE before including kmeans_builder.inl"
 #endif
 
 // The CPU backend finishes one-piece nodes with the hand-written subtree path.
@@ -57,57 +50,8 @@
 namespace kmbvh {
 namespace KMBVH_BACKEND_NAMESPACE {
 
-// Working buffers are not value-initialised: every kernel writes what it later reads
-// (the cluster accumulators are cleared explicitly per pass), so filling fresh memory with
-// zeros would only cost time. This is Thrust's own uninitialized_allocator idiom.
-template <typename T>
-struct UninitializedAllocator : thrust::device_allocator<T> {
-  template <typename U>
-  struct rebind {
-    using other = UninitializedAllocator<U>;
-  };
-  KMBVH_HD void construct(T*) {}
-};
-
-template <typename T>
-using Buffer = thrust::device_vector<T, UninitializedAllocator<T>>;
-
-template <typename T>
-T* ptr(Buffer<T>& b) {
-  return thrust::raw_pointer_cast(b.data());
-}
-
-template <typename T>
-void grow_to(Buffer<T>& b, size_t n) {
-  if (b.size() < n) b.resize(n);
-}
-
-template <typename F>
-void for_each_index(uint32_t n, const F& f) {
-  if (n > 0) thrust::for_each_n(thrust::device, thrust::counting_iterator<uint32_t>(0), n, f);
-}
-
-struct JoinBoxes {
-  KMBVH_HD Aabb operator()(const Aabb& a, const Aabb& b) const { return join(a, b); }
-};
-
 struct IsSplitByIndex {
   KMBVH_HD bool operator()(const Segment& s) const { return s.split_by_index != 0; }
-};
-
-// Times phases on the host; every Thrust algorithm used here blocks until it is done.
-class PhaseClock {
- public:
-  explicit PhaseClock(BuildInfo* info) : info_(info), last_(std::chrono::steady_clock::now()) {}
-  void lap(const char* phase) {
-    const auto now = std::chrono::steady_clock::now();
-    if (info_) info_->add_phase(phase, std::chrono::duration<double, std::milli>(now - last_).count());
-    last_ = now;
-  }
-
- private:
-  BuildInfo* info_;
-  std::chrono::steady_clock::time_point last_;
 };
 
 template <uint32_t KMax, ClusterMetric M>
@@ -126,8 +70,7 @@ class KMeansLevels {
   }
 
   Bvh run() {
-    const Aabb root_box = thrust::reduce(thrust::device, boxes_[0].begin(), boxes_[0].end(),
-                                         Aabb::empty(), JoinBoxes{});
+    const Aabb root_box = bounds_of(boxes_[0], n_);
     nodes_.resize(1);
     nodes_[0] = BvhNode::make_interior(root_box, 0, 0);
     node_count_ = 1;
@@ -331,24 +274,18 @@ class KMeansLevels {
             pieces_, piece_counters_, reps_, sums_, counts_, bounds_, cluster_begin_, cluster_segment_,
             child_counts_, child_offsets_);
     Bvh raw;
-    raw.nodes.resize(node_count_);
-    thrust::copy(nodes_.begin(), nodes_.begin() + node_count_, raw.nodes.begin());
+    raw.nodes = to_host(nodes_, node_count_);
     release(nodes_);
 #if KMBVH_CPU_SUBTREES
     append_subtrees(raw.nodes);
 #endif
-    raw.prim_indices.resize(n_);
-    thrust::copy(final_ids_.begin(), final_ids_.end(), raw.prim_indices.begin());
+    raw.prim_indices = to_host(final_ids_, n_);
     release(final_ids_);
     Bvh bvh = reorder_breadth_first(std::move(raw));
     clock_.lap("finish");
     return bvh;
   }
 
-  template <typename... Buffers>
-  static void release(Buffers&... buffers) {
-    (..., (buffers.clear(), buffers.shrink_to_fit()));
-  }
 
   const KMeansParams params_;
   const uint32_t n_;

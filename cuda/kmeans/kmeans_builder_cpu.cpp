@@ -2,6 +2,7 @@
 // Pieces are large so that each OpenMP work item amortises its per-cluster publishing, and
 // nodes of one piece or less are finished by the CPU subtree path (subtree_cpu.h).
 #define KMBVH_BACKEND_NAMESPACE cpu_backend
+#define KMBVH_BACKEND_CPU 1
 #define KMBVH_PIECE_SIZE 2048u
 #define KMBVH_CPU_SUBTREES 1
 #include "kmeans_builder.inl"

@@ -4,21 +4,10 @@
 #define KMBVH_PIECE_SIZE 64u
 #include "kmeans_builder.inl"
 
-#include <cuda_runtime.h>
-
 namespace kmbvh::detail {
 
 Bvh build_kmeans_gpu(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info) {
   return gpu_backend::build(prims, params, info);
-}
-
-bool cuda_device_present() {
-  int devices = 0;
-  if (cudaGetDeviceCount(&devices) != cudaSuccess) {
-    cudaGetLastError();  // clear the sticky "no device" error
-    return false;
-  }
-  return devices > 0;
 }
 
 }  // namespace kmbvh::detail

@@ -29,7 +29,10 @@ void add_bench_command(CLI::App& app, BenchCommand& c) {
   cmd->add_option("scenes", c.scenes,
                   "scene files or names in $KMBVH_SCENES; 'default' is the embedded scene "
                   "(default: sponza_dabrovic sibenik conference)");
-  cmd->add_option("--builders", c.builders, "comma-separated: Q1..Q5, kmeans:Qn, embree-low|medium|high");
+  cmd->add_option("--builders", c.builders,
+                  "comma-separated builders (sweep-sah, lbvh, hlbvh, atrbvh, ploc, Q1..Q5, embree-low|medium|high), "
+                  "or all");
+  add_reference_options(*cmd, c.options);
   cmd->add_option("--reference", c.reference, "the builder build-time ratios are taken against");
   cmd->add_option("--csv", c.csv_path, "also write the rows to this CSV file");
   add_run_options(*cmd, c.run);
@@ -39,7 +42,15 @@ int run_bench(const BenchCommand& c) {
   apply_run_options(c.run);
   std::vector<BuilderConfig> configs;
   for (const std::string& spec : split_list(c.builders)) {
-    BuilderOptions options;
+    if (spec == "all") {
+      for (const BuilderConfig& b : all_builders()) {
+        BuilderOptions options = c.options;
+        options.builder = b.builder == "kmeans" ? b.preset : b.builder;
+        configs.push_back(builder_config(options, c.run));
+      }
+      continue;
+    }
+    BuilderOptions options = c.options;
     options.builder = spec;
     configs.push_back(builder_config(options, c.run));
   }
@@ -62,6 +73,7 @@ int run_bench(const BenchCommand& c) {
       };
       rows.push_back(measure(scene, config, options));
     }
+    normalise_to_sweep(rows);
     tables.push_back(std::move(rows));
   }
   progress.done();

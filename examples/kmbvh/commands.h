@@ -2,6 +2,8 @@
 #pragma once
 
 #include <CLI/CLI.hpp>
+
+#include "cuda/binary/binary_params.h"
 #include <string>
 #include <vector>
 
@@ -29,6 +31,7 @@ struct BuilderOptions {
   uint32_t seed = 1;
   std::string metric = "means";
   bool wide = false;
+  BinaryBuildParams binary;  // ploc radius, treelet size and iterations
 };
 
 struct BuildCommand {
@@ -39,9 +42,10 @@ struct BuildCommand {
 
 struct BenchCommand {
   std::vector<std::string> scenes{"sponza_dabrovic", "sibenik", "conference"};
-  std::string builders = "Q1,Q2,Q3,Q4,Q5,embree-medium";
+  std::string builders = "all";
   std::string reference = "embree-medium";
   std::string csv_path;
+  BuilderOptions options;  // the reference builders' own parameters
   RunOptions run;
 };
 

@@ -2,8 +2,6 @@
 // Embree's. `kmbvh build` runs one builder on one scene; `kmbvh bench` compares several.
 #include <fmt/format.h>
 
-#include <malloc.h>
-
 #include <CLI/CLI.hpp>
 #include <stdexcept>
 
@@ -12,10 +10,6 @@
 
 int main(int argc, char** argv) {
   using namespace kmbvh;
-  // Large blocks always come from mmap and go back to the system when freed. glibc would
-  // otherwise raise this threshold after the first large free and keep later builds'
-  // memory on its heap, and each build's memory could not be measured apart.
-  mallopt(M_MMAP_THRESHOLD, 256 * 1024);
   CLI::App app{"kmbvh: k-means BVH construction, measured against Embree"};
   app.require_subcommand(1);
   BuildCommand build;

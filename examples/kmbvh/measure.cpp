@@ -50,32 +50,44 @@ Measurement measure(const LoadedScene& scene, const BuilderConfig& config, const
   m.triangles = scene.triangles;
   m.config = config;
   m.threads = thread_count();
-
   prepare_builder(config);
-  const size_t rss_before = current_rss_bytes();
-  reset_peak_rss();
-  Bvh bvh;
-  const int total = options.warmup + options.runs;
-  for (int run = 0; run < total; ++run) {
-    if (options.progress)
-      options.progress(run < options.warmup ? fmt::format("{}: {} warm-up", scene.name, config.label())
-                                            : fmt::format("{}: {} run {}/{}", scene.name, config.label(),
-                                                          run - options.warmup + 1, options.runs));
-    bvh = Bvh();  // the previous tree's memory is not the next build's
-    BuildInfo info;
+
+  auto build = [&](BuildInfo& info) {
     const auto start = std::chrono::steady_clock::now();
-    bvh = run_builder(config, scene.prims, &info);
+    Bvh bvh = run_builder(config, scene.prims, &info);
     const double ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-    if (run >= options.warmup) m.build_ms_runs.push_back(ms - info.excluded_ms);
-    m.info = info;
+    return std::make_pair(std::move(bvh), ms - info.excluded_ms);
+  };
+  auto report = [&](const std::string& what) {
+    if (options.progress) options.progress(fmt::format("{}: {} {}", scene.name, config.label(), what));
+  };
+
+  // Memory: the first build, on a trimmed heap. It also warms the allocator up.
+  report("memory");
+  const bool resettable = start_peak_rss_measurement();
+  const size_t rss_before = current_rss_bytes();
+  {
+    BuildInfo info;
+    build(info);
   }
   const size_t peak = peak_rss_bytes();
-  m.build_ms = median(m.build_ms_runs);
   m.peak_rss_mb = peak / 1048576.0;
-  m.build_memory_mb = peak > rss_before ? (peak - rss_before) / 1048576.0 : 0.0;
+  m.build_memory_mb = resettable && peak > rss_before ? (peak - rss_before) / 1048576.0 : 0.0;
   m.build_bytes_per_triangle = scene.prims.empty() ? 0.0 : m.build_memory_mb * 1048576.0 / scene.prims.size();
 
-  if (options.progress) options.progress(fmt::format("{}: {} validating", scene.name, config.label()));
+  Bvh bvh;
+  for (int run = 0; run < options.warmup + options.runs; ++run) {
+    report(run < options.warmup ? "warm-up" : fmt::format("run {}/{}", run - options.warmup + 1, options.runs));
+    bvh = Bvh();  // the previous tree's memory is not the next build's
+    BuildInfo info;
+    auto [tree, ms] = build(info);
+    bvh = std::move(tree);
+    if (run >= options.warmup) m.build_ms_runs.push_back(ms);
+    m.info = info;
+  }
+  m.build_ms = median(m.build_ms_runs);
+
+  report("validating");
   m.stats = tree_stats(bvh);
   m.validation = validate(bvh, scene.prims, validation_limits(config));
   m.sah_cost = m.validation.sah_reported;

@@ -1,5 +1,6 @@
-// Running one builder on one scene the way DESIGN.md §6 measures: warm-up, several timed
-// runs (median reported), memory of the build, then the full validation of the tree.
+// Running one builder on one scene the way DESIGN.md §6 measures: a first run that
+// measures the build's memory (from a trimmed heap), warm-up, several timed runs in the
+// allocator's steady state (median reported), then the full validation of the tree.
 #pragma once
 
 #include <cstddef>
@@ -40,10 +41,11 @@ struct Measurement {
   std::vector<double> build_ms_runs;
   double build_ms = 0;  // median of the runs
   double sah_cost = 0;
+  double sah_over_sweep = 0;  // SAH cost over sweep-sah's on the same scene, when both ran (else 0)
   TreeStats stats;
   ValidationReport validation;
-  double peak_rss_mb = 0;              // the process's high-water mark during the builds
-  double build_memory_mb = 0;          // that mark minus the resident size before them
+  double peak_rss_mb = 0;              // the process's high-water mark during the first build
+  double build_memory_mb = 0;          // that mark minus the resident size before it
   double build_bytes_per_triangle = 0;
   BuildInfo info;                      // of the last run
 };

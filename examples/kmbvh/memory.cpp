@@ -1,5 +1,7 @@
 #include "memory.h"
 
+#include <malloc.h>
+
 #include <fstream>
 #include <string>
 
@@ -25,7 +27,8 @@ size_t status_field_kib(const char* field) {
 size_t current_rss_bytes() { return status_field_kib("VmRSS:") * 1024; }
 size_t peak_rss_bytes() { return status_field_kib("VmHWM:") * 1024; }
 
-bool reset_peak_rss() {
+bool start_peak_rss_measurement() {
+  malloc_trim(0);
   std::ofstream clear("/proc/self/clear_refs");
   clear << "5";
   clear.flush();

@@ -18,6 +18,12 @@ std::string ratio_text(double value, double reference) {
 
 }  // namespace
 
+void normalise_to_sweep(std::vector<Measurement>& rows) {
+  const Measurement* sweep = find_label(rows, "sweep-sah");
+  if (!sweep || !(sweep->sah_cost > 0)) return;
+  for (Measurement& m : rows) m.sah_over_sweep = m.sah_cost / sweep->sah_cost;
+}
+
 std::optional<PaperFigures> paper_figures_for(const Measurement& m) {
   const BuilderConfig& c = m.config;
   if (c.builder == "kmeans") {
@@ -68,6 +74,7 @@ nlohmann::json to_json(const Measurement& m) {
     j["paper_sah_cost"] = paper->sah_cost;
     j["sah_cost_over_paper"] = m.sah_cost / paper->sah_cost;
   }
+  if (m.sah_over_sweep > 0) j["sah_cost_over_sweep_sah"] = m.sah_over_sweep;
   return j;
 }
 
@@ -108,31 +115,34 @@ void print_scene_table(const std::vector<Measurement>& rows, const std::string& 
   const Measurement& first = rows.front();
   fmt::print("\n{}: {} triangles, {} threads, median of {} runs\n", first.scene, first.triangles, first.threads,
              first.build_ms_runs.size());
-  fmt::print("{:<22} {:>9} {:>7} {:>9} {:>11} {:>9} {:>8} {:>6} {:>6}  {}\n", "builder", "SAH cost", "paper",
-             "SAH/paper", "build ms", "ratio", "B/tri", "depth", "leaf", "valid");
+  fmt::print("{:<22} {:>9} {:>9} {:>7} {:>9} {:>11} {:>9} {:>8} {:>6} {:>6}  {}\n", "builder", "SAH cost",
+             "/sweep", "paper", "/paper", "build ms", "ratio", "B/tri", "depth", "leaf", "valid");
   for (const Measurement& m : rows) {
     const auto paper = paper_figures_for(m);
-    fmt::print("{:<22} {:>9.2f} {:>7} {:>9} {:>11.2f} {:>9} {:>8.1f} {:>6} {:>6}  {}\n", m.config.label(),
-               m.sah_cost, paper ? fmt::format("{:.0f}", paper->sah_cost) : "-",
+    fmt::print("{:<22} {:>9.2f} {:>9} {:>7} {:>9} {:>11.2f} {:>9} {:>8.1f} {:>6} {:>6}  {}\n", m.config.label(),
+               m.sah_cost, m.sah_over_sweep > 0 ? fmt::format("{:.3f}", m.sah_over_sweep) : "-",
+               paper ? fmt::format("{:.0f}", paper->sah_cost) : "-",
                paper ? fmt::format("{:.3f}", m.sah_cost / paper->sah_cost) : "-", m.build_ms,
                ref ? ratio_text(m.build_ms, ref->build_ms) : "-", m.build_bytes_per_triangle, m.stats.max_depth,
                m.stats.max_leaf_size, m.validation.ok() ? "yes" : "NO: " + m.validation.summary());
   }
-  if (ref) fmt::print("ratio: build time over {} in this run\n", reference);
+  fmt::print("/sweep: SAH cost over sweep-sah's; paper: the paper's Table 1; ratio: build time over {} in this run\n",
+             reference);
 }
 
 std::string csv_header() {
-  return "scene,triangles,builder,threads,build_ms,build_ms_over_reference,sah_cost,paper_sah_cost,nodes,leaves,"
-         "max_depth,max_leaf_size,build_bytes_per_triangle,peak_rss_mb,valid";
+  return "scene,triangles,builder,threads,build_ms,build_ms_over_reference,sah_cost,sah_cost_over_sweep_sah,"
+         "paper_sah_cost,nodes,leaves,max_depth,max_leaf_size,build_bytes_per_triangle,peak_rss_mb,valid";
 }
 
 std::string csv_row(const Measurement& m, const std::vector<Measurement>& same_scene, const std::string& reference) {
   const Measurement* ref = find_label(same_scene, reference);
   const auto paper = paper_figures_for(m);
-  return fmt::format("{},{},\"{}\",{},{:.4f},{},{:.4f},{},{},{},{},{},{:.2f},{:.2f},{}", m.scene, m.triangles,
+  return fmt::format("{},{},\"{}\",{},{:.4f},{},{:.4f},{},{},{},{},{},{},{:.2f},{:.2f},{}", m.scene, m.triangles,
                      m.config.label(), m.threads, m.build_ms,
                      ref && ref->build_ms > 0 ? fmt::format("{:.4f}", m.build_ms / ref->build_ms) : "",
-                     m.sah_cost, paper ? fmt::format("{:.0f}", paper->sah_cost) : "", m.stats.nodes, m.stats.leaves,
+                     m.sah_cost, m.sah_over_sweep > 0 ? fmt::format("{:.4f}", m.sah_over_sweep) : "",
+                     paper ? fmt::format("{:.0f}", paper->sah_cost) : "", m.stats.nodes, m.stats.leaves,
                      m.stats.max_depth, m.stats.max_leaf_size, m.build_bytes_per_triangle, m.peak_rss_mb,
                      m.validation.ok() ? "true" : "false");
 }

@@ -18,6 +18,9 @@ nlohmann::json to_json(const Measurement& m);
 
 void print_measurement(const Measurement& m);
 
+// Sets every row's sah_over_sweep from the scene's sweep-sah row, if there is one.
+void normalise_to_sweep(std::vector<Measurement>& rows);
+
 // One table for one scene; build-time ratios are to the row labelled `reference` (when present).
 void print_scene_table(const std::vector<Measurement>& rows, const std::string& reference);
 

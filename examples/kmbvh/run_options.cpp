@@ -19,6 +19,12 @@ void add_run_options(CLI::App& cmd, RunOptions& run) {
   cmd.add_flag("-q,--quiet", run.quiet, "no progress on stderr");
 }
 
+void add_reference_options(CLI::App& cmd, BuilderOptions& o) {
+  cmd.add_option("--ploc-radius", o.binary.ploc_radius, "PLOC: neighbours searched on each side");
+  cmd.add_option("--treelet-size", o.binary.treelet_size, "ATRBVH: leaves of a restructured treelet");
+  cmd.add_option("--treelet-iterations", o.binary.treelet_iterations, "ATRBVH: restructuring passes");
+}
+
 void apply_run_options(const RunOptions& run) { set_thread_count(run.threads); }
 
 Backend backend_of(const RunOptions& run) { return run.backend == "cuda" ? Backend::Cuda : Backend::Cpu; }
@@ -27,6 +33,9 @@ BuilderConfig builder_config(const BuilderOptions& o, const RunOptions& run) {
   BuilderConfig config = parse_builder(o.builder == "kmeans" ? "kmeans:" + o.preset : o.builder);
   config.max_leaf_size = o.max_leaf_size;
   config.backend = backend_of(run);
+  config.binary = o.binary;
+  config.binary.max_leaf_size = o.max_leaf_size;
+  if (const std::string problem = check_params(config.binary); !problem.empty()) throw std::invalid_argument(problem);
   if (config.builder != "kmeans") return config;
   const bool custom = (o.k_opt && o.k_opt->count()) || (o.p_opt && o.p_opt->count()) || (o.i_opt && o.i_opt->count());
   if (custom) config.preset.clear();

@@ -1,7 +1,8 @@
-// The k-means builder on the GPU backend: the same kernels, compiled by nvcc. Runs where a
-// CUDA device is present (the device machine), and is skipped, saying so, elsewhere.
+// The portable builders on the GPU backend: the same kernels, compiled by nvcc. Runs where
+// a CUDA device is present (the device machine), and is skipped, saying so, elsewhere.
 #include <gtest/gtest.h>
 
+#include "cuda/binary/binary_builders.h"
 #include "cuda/kmeans/kmeans_builder.h"
 #include "cuda/metrics/sah.h"
 #include "cuda/metrics/validate.h"
@@ -38,6 +39,26 @@ TEST(KMeansGpu, DegenerateInputs) {
     const PrimitiveSet prims = make_primitive_set(scene);
     const Bvh bvh = build_kmeans(prims, *kmeans_preset("Q3"), Backend::Cuda);
     EXPECT_TRUE(validate(bvh, prims, {}).ok()) << scene.name;
+  }
+}
+
+TEST(BinaryBuildersGpu, ValidTreesAsGoodAsTheCpuBackend) {
+  if (!cuda_device_available()) GTEST_SKIP() << "no CUDA device: the GPU backend is compiled but not run here";
+  using Build = Bvh (*)(const PrimitiveSet&, const BinaryBuildParams&, Backend, BuildInfo*);
+  const std::pair<const char*, Build> builders[] = {
+      {"lbvh", build_lbvh}, {"hlbvh", build_hlbvh}, {"atrbvh", build_atrbvh}, {"ploc", build_ploc}};
+  for (const TriangleScene& scene : {test::clustered_triangles(200000, 54), test::identical_triangles(100000),
+                                     test::shared_centroid_triangles(20000), test::random_triangles(2, 55)}) {
+    const PrimitiveSet prims = make_primitive_set(scene);
+    for (const auto& [name, build] : builders) {
+      const Bvh gpu = build(prims, BinaryBuildParams{}, Backend::Cuda, nullptr);
+      const Bvh cpu = build(prims, BinaryBuildParams{}, Backend::Cpu, nullptr);
+      const ValidationReport report = validate(gpu, prims, {});
+      EXPECT_TRUE(report.ok()) << name << " on " << scene.name << ": " << report.summary();
+      if (sah_cost(cpu) > 0) {
+        EXPECT_NEAR(sah_cost(gpu) / sah_cost(cpu), 1.0, 0.02) << name << " on " << scene.name;
+      }
+    }
   }
 }
 

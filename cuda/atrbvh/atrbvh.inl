@@ -1,0 +1,42 @@
+// ATRBVH (Domingues and Pedrini 2015, DESIGN.md §5): the LBVH radix tree, restructured by
+// agglomerative treelets (treelet_restructure.h) in `treelet_iterations` bottom-up passes,
+// then SAH leaf collapse. Portable: included by binary_builders_cpu.cpp and _gpu.cu, after
+// lbvh.inl.
+#pragma once
+
+#include <thrust/fill.h>
+
+#include "../binary/climb.h"
+#include "treelet_restructure.h"
+
+namespace kmbvh {
+namespace KMBVH_BACKEND_NAMESPACE {
+
+inline Bvh build_atrbvh(const PrimitiveSet& prims, const BinaryBuildParams& params, BuildInfo* info) {
+  const auto n = static_cast<uint32_t>(prims.size());
+  if (n < 2) return Bvh::single_leaf(prims.bounds(), n);
+  PhaseClock clock(info);
+  MortonRadixTree radix;
+  CollapseState state(n);
+  build_morton_radix_tree(prims, radix, state, params, /*with_ranges=*/false, clock);
+  release(radix.codes);
+  const BinaryTreeView tree = radix.view();
+
+  Buffer<uint32_t> visits(n - 1);
+  for (uint32_t pass = 0; pass < params.treelet_iterations; ++pass) {
+    if (info) ++info->levels;
+    thrust::fill(thrust::device, visits.begin(), visits.end(), 0u);
+    for_each_index(n, climb_from_leaves(tree, ptr(visits), RestructureTreelet{tree, state.view(), params.sah,
+                                                                             params.max_leaf_size,
+                                                                             params.treelet_size}));
+  }
+  release(visits);
+  clock.lap("restructure");
+  collapse(tree, state, params.max_leaf_size, params.sah, /*refit=*/true);
+  Bvh bvh = lay_out(tree, state.view());
+  clock.lap("layout");
+  return bvh;
+}
+
+}  // namespace KMBVH_BACKEND_NAMESPACE
+}  // namespace kmbvh

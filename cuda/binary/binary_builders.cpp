@@ -1,0 +1,56 @@
+#include "binary_builders.h"
+
+#include <fmt/format.h>
+
+#include <stdexcept>
+
+namespace kmbvh {
+
+std::string check_params(const BinaryBuildParams& p) {
+  if (p.max_leaf_size < 1 || p.max_leaf_size > BinaryBuildParams::kMaxLeafSize)
+    return fmt::format("the max leaf size must be in [1, {}], got {}", BinaryBuildParams::kMaxLeafSize, p.max_leaf_size);
+  if (p.ploc_radius < 1 || p.ploc_radius > 1024)
+    return fmt::format("the PLOC search radius must be in [1, 1024], got {}", p.ploc_radius);
+  if (p.treelet_size < 3 || p.treelet_size > BinaryBuildParams::kMaxTreeletSize)
+    return fmt::format("the treelet size must be in [3, {}], got {}", BinaryBuildParams::kMaxTreeletSize, p.treelet_size);
+  if (p.treelet_iterations > 100)
+    return fmt::format("treelet iterations must be at most 100, got {}", p.treelet_iterations);
+  return {};
+}
+
+namespace {
+
+using BuildFunction = Bvh (*)(const PrimitiveSet&, const BinaryBuildParams&, BuildInfo*);
+
+Bvh dispatch(BuildFunction cpu, [[maybe_unused]] BuildFunction gpu, const PrimitiveSet& prims,
+             const BinaryBuildParams& params, Backend backend, BuildInfo* info) {
+  if (const std::string problem = check_params(params); !problem.empty()) throw std::invalid_argument(problem);
+  require_backend(backend);
+#if defined(KMBVH_HAS_CUDA)
+  if (backend == Backend::Cuda) return gpu(prims, params, info);
+#endif
+  return cpu(prims, params, info);
+}
+
+#if defined(KMBVH_HAS_CUDA)
+#define KMBVH_GPU(name) detail::build_##name##_gpu
+#else
+#define KMBVH_GPU(name) nullptr
+#endif
+
+}  // namespace
+
+Bvh build_lbvh(const PrimitiveSet& p, const BinaryBuildParams& q, Backend b, BuildInfo* i) {
+  return dispatch(detail::build_lbvh_cpu, KMBVH_GPU(lbvh), p, q, b, i);
+}
+Bvh build_hlbvh(const PrimitiveSet& p, const BinaryBuildParams& q, Backend b, BuildInfo* i) {
+  return dispatch(detail::build_hlbvh_cpu, KMBVH_GPU(hlbvh), p, q, b, i);
+}
+Bvh build_atrbvh(const PrimitiveSet& p, const BinaryBuildParams& q, Backend b, BuildInfo* i) {
+  return dispatch(detail::build_atrbvh_cpu, KMBVH_GPU(atrbvh), p, q, b, i);
+}
+Bvh build_ploc(const PrimitiveSet& p, const BinaryBuildParams& q, Backend b, BuildInfo* i) {
+  return dispatch(detail::build_ploc_cpu, KMBVH_GPU(ploc), p, q, b, i);
+}
+
+}  // namespace kmbvh

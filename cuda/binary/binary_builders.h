@@ -1,0 +1,36 @@
+// The paper's reference builders that make a binary tree with one primitive per leaf and
+// then collapse leaves by SAH (DESIGN.md §5): LBVH, HLBVH, ATRBVH and PLOC. Portable like
+// k-means: the same kernels on the CPU backend and, when built with nvcc, on the GPU.
+#pragma once
+
+#include "../core/backend.h"
+#include "../core/build_info.h"
+#include "../core/bvh.h"
+#include "../core/primitive_set.h"
+#include "binary_params.h"
+
+namespace kmbvh {
+
+// Each throws std::invalid_argument for parameters check_params() rejects, and
+// std::runtime_error when the backend cannot run.
+Bvh build_lbvh(const PrimitiveSet& prims, const BinaryBuildParams& params, Backend backend = Backend::Cpu,
+               BuildInfo* info = nullptr);
+Bvh build_hlbvh(const PrimitiveSet& prims, const BinaryBuildParams& params, Backend backend = Backend::Cpu,
+                BuildInfo* info = nullptr);
+Bvh build_atrbvh(const PrimitiveSet& prims, const BinaryBuildParams& params, Backend backend = Backend::Cpu,
+                 BuildInfo* info = nullptr);
+Bvh build_ploc(const PrimitiveSet& prims, const BinaryBuildParams& params, Backend backend = Backend::Cpu,
+               BuildInfo* info = nullptr);
+
+namespace detail {
+#define KMBVH_DECLARE_BINARY_BUILDER(name)                                                             \
+  Bvh build_##name##_cpu(const PrimitiveSet& prims, const BinaryBuildParams& params, BuildInfo* info); \
+  Bvh build_##name##_gpu(const PrimitiveSet& prims, const BinaryBuildParams& params, BuildInfo* info);
+KMBVH_DECLARE_BINARY_BUILDER(lbvh)
+KMBVH_DECLARE_BINARY_BUILDER(hlbvh)
+KMBVH_DECLARE_BINARY_BUILDER(atrbvh)
+KMBVH_DECLARE_BINARY_BUILDER(ploc)
+#undef KMBVH_DECLARE_BINARY_BUILDER
+}  // namespace detail
+
+}  // namespace kmbvh

@@ -1,0 +1,74 @@
+// The last steps of every binary builder, portable (included from a builder's .inl):
+// bottom-up SAH costs and leaf collapse (collapse.h), then the breadth-first layout
+// (emit_binary.h) into a Bvh.
+#pragma once
+
+#include <thrust/fill.h>
+#include <thrust/scan.h>
+
+#include "../core/portable.h"
+#include "climb.h"
+#include "collapse.h"
+#include "emit_binary.h"
+
+namespace kmbvh {
+namespace KMBVH_BACKEND_NAMESPACE {
+
+// Per-node counts, costs and collapse flags of a binary tree of n leaves.
+struct CollapseState {
+  Buffer<uint32_t> count;
+  Buffer<float> cost;
+  Buffer<uint8_t> collapsed;
+
+  explicit CollapseState(uint32_t n) : count(2 * n - 1), cost(2 * n - 1), collapsed(2 * n - 1) {}
+  CollapseView view() { return {ptr(count), ptr(cost), ptr(collapsed)}; }
+};
+
+// Costs and collapse flags for a tree whose topology is final. The leaves' boxes must be
+// set; with refit, inner boxes are computed on the way up, else they must be set too.
+inline void collapse(const BinaryTreeView& tree, CollapseState& state, uint32_t max_leaf_size, SahCosts k, bool refit) {
+  Buffer<uint32_t> visits(tree.n - 1);
+  thrust::fill(thrust::device, visits.begin(), visits.end(), 0u);
+  for_each_index(tree.n, InitLeaves{tree, state.view(), k, nullptr});
+  for_each_index(tree.n, climb_from_leaves(tree, ptr(visits), CollapseNode{tree, state.view(), k, max_leaf_size, refit}));
+}
+
+// The collapsed tree as a Bvh, laid out breadth-first one level per step. range_first:
+// see WriteLevel (the leaf order is then the primitive order, copied as it is).
+inline Bvh lay_out(const BinaryTreeView& tree, CollapseView view, const uint32_t* range_first = nullptr) {
+  const uint32_t n = tree.n;
+  Buffer<uint32_t> frontier(1), next_frontier;
+  frontier[0] = tree.root;
+  Buffer<LevelCounts> counts, offsets;
+  Buffer<BvhNode> nodes;
+  nodes.reserve(n);
+  Buffer<uint32_t> prim_indices(range_first ? 0 : n);
+  uint32_t level = 1, level_base = 0, prim_base = 0;
+  while (level > 0) {
+    grow_to(counts, level);
+    grow_to(offsets, level);
+    for_each_index(level, CountLevel{ptr(frontier), view, ptr(counts)});
+    thrust::exclusive_scan(thrust::device, counts.begin(), counts.begin() + level, offsets.begin(), LevelCounts{},
+                           AddLevelCounts{});
+    const LevelCounts total = AddLevelCounts{}(offsets[level - 1], counts[level - 1]);
+    const uint32_t next_base = level_base + level;
+    nodes.resize(next_base + total.children);
+    grow_to(next_frontier, total.children);
+    for_each_index(level, WriteLevel{tree, view, ptr(frontier), ptr(offsets), level_base, next_base, prim_base,
+                                     ptr(nodes), ptr(prim_indices), ptr(next_frontier), range_first});
+    std::swap(frontier, next_frontier);
+    level_base = next_base;
+    prim_base += total.prims;
+    level = total.children;
+  }
+  Bvh bvh;
+  bvh.nodes = to_host(nodes, nodes.size());
+  if (range_first)
+    bvh.prim_indices.assign(tree.order, tree.order + n);
+  else
+    bvh.prim_indices = to_host(prim_indices, n);
+  return bvh;
+}
+
+}  // namespace KMBVH_BACKEND_NAMESPACE
+}  // namespace kmbvh

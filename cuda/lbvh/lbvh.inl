@@ -1,0 +1,81 @@
+// LBVH (Karras 2012, DESIGN.md §5): primitives in 60-bit Morton order, the binary radix
+// tree over the sorted codes built bottom-up with boxes, costs and collapse decisions on
+// the way (radix_tree.h, collapse.h), leaves collapsed by SAH up to the max leaf size.
+// Portable: included by binary_builders_cpu.cpp and _gpu.cu.
+#pragma once
+
+#include <thrust/fill.h>
+
+#include "../binary/binary_params.h"
+#include "../binary/finish_binary.h"
+#include "../binary/radix_tree.h"
+#include "../core/primitive_set.h"
+#include "../morton/morton_order.h"
+
+namespace kmbvh {
+namespace KMBVH_BACKEND_NAMESPACE {
+
+// The radix tree over the Morton order, with boxes, counts, costs and collapse flags of
+// every node. HLBVH and ATRBVH start from it too.
+struct MortonRadixTree {
+  uint32_t n = 0;
+  Buffer<unsigned long long> codes;
+  Buffer<uint32_t> order, left, right, parent, root;
+  Buffer<uint32_t> range_first, range_last;  // per inner node, when asked for
+  Buffer<Aabb> node_box;
+
+  BinaryTreeView view() {
+    BinaryTreeView t;
+    t.n = n;
+    t.root = root.empty() ? 0 : uint32_t(root[0]);
+    t.left = ptr(left);
+    t.right = ptr(right);
+    t.parent = ptr(parent);
+    t.box = ptr(node_box);
+    t.order = ptr(order);
+    return t;
+  }
+};
+
+// n >= 2. with_ranges: also keep each inner node's range of leaves (HLBVH needs them).
+inline void build_morton_radix_tree(const PrimitiveSet& prims, MortonRadixTree& t, CollapseState& state,
+                                    const BinaryBuildParams& params, bool with_ranges, PhaseClock& clock) {
+  t.n = static_cast<uint32_t>(prims.size());
+  const InputBoxes boxes(prims.boxes);
+  morton_order(boxes.data(), t.n, t.codes, t.order);
+  clock.lap("morton");
+  t.left.resize(t.n - 1);
+  t.right.resize(t.n - 1);
+  t.parent.resize(2 * t.n - 1);
+  t.node_box.resize(2 * t.n - 1);
+  t.root.resize(1);
+  Buffer<uint32_t> other_end(t.n - 1);
+  thrust::fill(thrust::device, other_end.begin(), other_end.end(), kNotYet);
+  BinaryTreeView tree = t.view();
+  for_each_index(t.n, InitLeaves{tree, state.view(), params.sah, boxes.data()});
+  auto build = build_radix_tree(ptr(t.codes), tree, ptr(other_end), ptr(t.root),
+                                CollapseNode{tree, state.view(), params.sah, params.max_leaf_size, /*refit=*/true});
+  if (with_ranges) {
+    t.range_first.resize(t.n - 1);
+    t.range_last.resize(t.n - 1);
+    build.range_first = ptr(t.range_first);
+    build.range_last = ptr(t.range_last);
+  }
+  for_each_index(t.n, build);
+  clock.lap("radix tree");
+}
+
+inline Bvh build_lbvh(const PrimitiveSet& prims, const BinaryBuildParams& params, BuildInfo* info) {
+  if (prims.size() < 2) return Bvh::single_leaf(prims.bounds(), uint32_t(prims.size()));
+  PhaseClock clock(info);
+  MortonRadixTree tree;
+  CollapseState state(uint32_t(prims.size()));
+  build_morton_radix_tree(prims, tree, state, params, /*with_ranges=*/true, clock);
+  release(tree.codes);
+  Bvh bvh = lay_out(tree.view(), state.view(), ptr(tree.range_first));
+  clock.lap("layout");
+  return bvh;
+}
+
+}  // namespace KMBVH_BACKEND_NAMESPACE
+}  // namespace kmbvh

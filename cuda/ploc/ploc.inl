@@ -1,0 +1,105 @@
+// PLOC (Meister and Bittner 2018, DESIGN.md §5): bottom-up clustering in Morton order,
+// iterations of ploc_steps.h until one cluster is left, then SAH leaf collapse. Portable:
+// included by binary_builders_cpu.cpp and _gpu.cu.
+#pragma once
+
+#include <thrust/scan.h>
+#include <thrust/sequence.h>
+
+#include "../binary/binary_params.h"
+#include "../binary/finish_binary.h"
+#include "../core/primitive_set.h"
+#include "../morton/morton_order.h"
+#include "ploc_steps.h"
+
+namespace kmbvh {
+namespace KMBVH_BACKEND_NAMESPACE {
+
+struct CopyToColumns {
+  const Aabb* boxes;
+  BoxColumns columns;
+  KMBVH_HD void operator()(uint32_t i) const { columns.set(i, boxes[i]); }
+};
+
+// The nearest-neighbour search, sized by the radius (its window is a local array). The CPU
+// works in blocks that compute each pair once, while the radius keeps the block's table small.
+inline void find_nearest(uint32_t count, uint32_t radius, BoxColumns box, Buffer<uint32_t>& nearest) {
+#if KMBVH_BACKEND_CPU
+  constexpr uint32_t kBlock = 256;
+  if (radius <= 32) {
+    for_each_index((count + kBlock - 1) / kBlock, FindNearestInBlocks<32, kBlock>{box, count, radius, ptr(nearest)});
+    return;
+  }
+#endif
+  if (radius <= 16)
+    for_each_index(count, FindNearest<16>{box, count, radius, ptr(nearest)});
+  else if (radius <= 64)
+    for_each_index(count, FindNearest<64>{box, count, radius, ptr(nearest)});
+  else
+    for_each_index(count, FindNearest<1024>{box, count, radius, ptr(nearest)});
+}
+
+inline Bvh build_ploc(const PrimitiveSet& prims, const BinaryBuildParams& params, BuildInfo* info) {
+  const auto n = static_cast<uint32_t>(prims.size());
+  if (n < 2) return Bvh::single_leaf(prims.bounds(), n);
+  PhaseClock clock(info);
+  const InputBoxes boxes(prims.boxes);
+  Buffer<unsigned long long> codes;
+  Buffer<uint32_t> order;
+  morton_order(boxes.data(), n, codes, order);
+  release(codes);
+  clock.lap("morton");
+
+  Buffer<uint32_t> left(n - 1), right(n - 1), parent(2 * n - 1);
+  Buffer<Aabb> node_box(2 * n - 1);
+  BinaryTreeView tree;
+  tree.n = n;
+  tree.left = ptr(left);
+  tree.right = ptr(right);
+  tree.parent = ptr(parent);
+  tree.box = ptr(node_box);
+  tree.order = ptr(order);
+  CollapseState state(n);
+  for_each_index(n, InitLeaves{tree, state.view(), params.sah, boxes.data()});
+
+  Buffer<uint32_t> clusters(n), next_clusters(n), nearest(n);
+  Buffer<float> box_columns[2] = {Buffer<float>(6 * size_t(n)), Buffer<float>(6 * size_t(n))};
+  BoxColumns cluster_box{ptr(box_columns[0]), n}, next_box{ptr(box_columns[1]), n};
+  for_each_index(n, CopyToColumns{tree.box, cluster_box});
+  Buffer<MergeCounts> counts(n), offsets(n);
+  thrust::sequence(thrust::device, clusters.begin(), clusters.end());  // leaf i: position i
+  uint32_t count = n, next_inner = n;
+  bool stalled = false;
+  while (count > 1) {
+    if (info) ++info->levels;
+    if (stalled) {
+      for_each_index(count, PairNeighbours{count, ptr(nearest)});
+      if (info) ++info->forced_splits;
+    } else {
+      find_nearest(count, params.ploc_radius, cluster_box, nearest);
+    }
+    for_each_index(count, CountMerges{ptr(nearest), ptr(counts)});
+    thrust::exclusive_scan(thrust::device, counts.begin(), counts.begin() + count, offsets.begin(), MergeCounts{},
+                           AddMergeCounts{});
+    const MergeCounts total = AddMergeCounts{}(offsets[count - 1], counts[count - 1]);
+    for_each_index(count, MergeAndCompact{ptr(clusters), cluster_box, ptr(nearest), ptr(offsets), next_inner, tree,
+                                          ptr(next_clusters), next_box});
+    std::swap(clusters, next_clusters);
+    std::swap(cluster_box, next_box);
+    next_inner += total.merges;
+    stalled = !stalled && total.merges * kPlocStallFraction < count;
+    count = total.kept;
+  }
+  tree.root = clusters[0];
+  parent[tree.root] = kNoParent;
+  release(clusters, next_clusters, nearest, counts, offsets, box_columns[0], box_columns[1]);
+  clock.lap("clustering");
+  collapse(tree, state, params.max_leaf_size, params.sah, /*refit=*/false);
+  clock.lap("collapse");
+  Bvh bvh = lay_out(tree, state.view());
+  clock.lap("layout");
+  return bvh;
+}
+
+}  // namespace KMBVH_BACKEND_NAMESPACE
+}  // namespace kmbvh

@@ -1,0 +1,212 @@
+// The steps of one PLOC iteration (Meister and Bittner 2018, "Parallel Locally-Ordered
+// Clustering for BVH Construction"): every cluster finds its nearest neighbour among the
+// `radius` clusters on either side in Morton order (distance: surface area of the merged
+// box), mutual nearest neighbours merge, and the survivors are compacted in order. A
+// cluster that is its own "neighbour" (PairNeighbours' odd one out) is simply kept.
+#pragma once
+
+#include <cfloat>
+#include <cstdint>
+
+#include "../binary/binary_tree.h"
+
+namespace kmbvh {
+
+// Candidates are ordered by merged area, then, for equal areas, by a symmetric rule on the
+// pair of positions: the closer pair in Morton order, then the pair starting at an even
+// position, then the lower one. Any strict order on pairs makes the globally first pair
+// mutual, so every iteration merges at least one pair; this one also pairs equal boxes
+// (0,1), (2,3), ... instead of chaining them (the PLOC paper leaves ties open).
+struct PairOrder {
+  float area;
+  uint32_t gap, odd, first;
+
+  KMBVH_HD static PairOrder of(float area, uint32_t i, uint32_t j) {
+    const uint32_t a = i < j ? i : j, b = i < j ? j : i;
+    return {area, b - a, a & 1u, a};
+  }
+  KMBVH_HD bool operator<(const PairOrder& o) const {
+    if (area != o.area) return area < o.area;
+    if (gap != o.gap) return gap < o.gap;
+    if (odd != o.odd) return odd < o.odd;
+    return first < o.first;
+  }
+};
+
+// Cluster boxes, kept contiguous in cluster order as six columns (MergeAndCompact writes
+// them): a cluster's window is then one sequential run whose merged areas a vectorised
+// loop computes, before the nearest is picked.
+struct BoxColumns {
+  float* data;      // 6 columns of `stride` floats: lo.x, lo.y, lo.z, hi.x, hi.y, hi.z
+  uint32_t stride;
+
+  KMBVH_HD Aabb get(uint32_t i) const {
+    return Aabb(Vec3(data[i], data[stride + i], data[2 * stride + i]),
+                Vec3(data[3 * stride + i], data[4 * stride + i], data[5 * stride + i]));
+  }
+  KMBVH_HD void set(uint32_t i, const Aabb& b) const {
+    for (int d = 0; d < 3; ++d) {
+      data[d * stride + i] = b.lo[d];
+      data[(3 + d) * stride + i] = b.hi[d];
+    }
+  }
+};
+
+KMBVH_HD KMBVH_INLINE float merged_area(const float* c, uint32_t s, uint32_t j, const Aabb& mine) {
+  const float dx = max(c[3 * s + j], mine.hi.x) - min(c[j], mine.lo.x);
+  const float dy = max(c[4 * s + j], mine.hi.y) - min(c[s + j], mine.lo.y);
+  const float dz = max(c[5 * s + j], mine.hi.z) - min(c[2 * s + j], mine.lo.z);
+  return 2.0f * (dx * dy + dy * dz + dz * dx);
+}
+
+// Of the candidates (area[t] is the merged area with position first + t; i itself holds
+// FLT_MAX), the nearest by PairOrder: the smallest area first (a branch-free reduction),
+// then the pair order among those reaching it (usually one).
+KMBVH_HD KMBVH_INLINE uint32_t pick_nearest(uint32_t i, uint32_t first, uint32_t last, const float* area) {
+  float smallest = FLT_MAX;
+  for (uint32_t j = first; j <= last; ++j) smallest = min(smallest, area[j - first]);
+  uint32_t reaching = 0;
+  for (uint32_t j = first; j <= last; ++j) reaching += area[j - first] == smallest ? 1u : 0u;
+  if (reaching == 1)  // no tie: the one candidate at the smallest area
+    for (uint32_t j = first;; ++j)
+      if (area[j - first] == smallest) return j;
+  PairOrder best{};
+  uint32_t best_j = i;
+  for (uint32_t j = first; j <= last; ++j) {
+    if (j == i || area[j - first] != smallest) continue;
+    const PairOrder candidate = PairOrder::of(smallest, i, j);
+    if (best_j == i || candidate < best) {
+      best = candidate;
+      best_j = j;
+    }
+  }
+  return best_j;
+}
+
+// One work item per cluster (the GPU's kernel): both sides of the window.
+template <uint32_t MaxRadius>
+struct FindNearest {
+  BoxColumns box;     // per position
+  uint32_t count;
+  uint32_t radius;    // at most MaxRadius
+  uint32_t* nearest;  // per position
+
+  KMBVH_HD void operator()(uint32_t i) const {
+    const Aabb mine = box.get(i);
+    const uint32_t lo = i > radius ? i - radius : 0;
+    const uint32_t hi = i + radius < count - 1 ? i + radius : count - 1;
+    float area[2 * MaxRadius + 1];
+    for (uint32_t j = lo; j <= hi; ++j) area[j - lo] = merged_area(box.data, box.stride, j, mine);  // vectorises
+    area[i - lo] = FLT_MAX;
+    nearest[i] = pick_nearest(i, lo, hi, area);
+  }
+};
+
+// One work item per block of clusters (the CPU's kernel): every pair in or just before the
+// block has its merged area computed once, forwards, into a local table, and each cluster
+// reads its backward neighbours from the table too; the PLOC paper caches distances in
+// shared memory for the same reason. Picks the same neighbours as FindNearest.
+template <uint32_t MaxRadius, uint32_t Block>
+struct FindNearestInBlocks {
+  BoxColumns box;
+  uint32_t count;
+  uint32_t radius;  // at most MaxRadius
+  uint32_t* nearest;
+
+  KMBVH_HD void operator()(uint32_t block) const {
+    const uint32_t a = block * Block, b = a + Block < count ? a + Block : count;
+    const uint32_t first = a > radius ? a - radius : 0;
+    float forward[(Block + MaxRadius) * MaxRadius];  // forward[(i - first) * radius + k]: i with i + 1 + k
+    for (uint32_t i = first; i < b; ++i) {
+      const Aabb mine = box.get(i);
+      float* row = forward + (i - first) * radius;
+      const uint32_t reach = i + radius < count - 1 ? radius : count - 1 - i;
+      for (uint32_t k = 0; k < reach; ++k) row[k] = merged_area(box.data, box.stride, i + 1 + k, mine);
+    }
+    float area[2 * MaxRadius + 1];
+    for (uint32_t i = a; i < b; ++i) {
+      const uint32_t lo = i > radius ? i - radius : 0;
+      const uint32_t hi = i + radius < count - 1 ? i + radius : count - 1;
+      for (uint32_t j = lo; j < i; ++j) area[j - lo] = forward[(j - first) * radius + (i - j - 1)];
+      area[i - lo] = FLT_MAX;
+      for (uint32_t j = i + 1; j <= hi; ++j) area[j - lo] = forward[(i - first) * radius + (j - i - 1)];
+      nearest[i] = pick_nearest(i, lo, hi, area);
+    }
+  }
+};
+
+// The progress guarantee: nested or chained boxes can make nearest neighbours a chain in
+// which few pairs are mutual, and PLOC would need O(n) iterations. After an iteration that
+// merges less than 1/16 of the clusters, the next one pairs positions (0,1), (2,3), ...
+// instead, so the number of clusters at least halves every two iterations.
+constexpr uint32_t kPlocStallFraction = 16;
+
+struct PairNeighbours {
+  uint32_t count;
+  uint32_t* nearest;
+
+  KMBVH_HD void operator()(uint32_t i) const { nearest[i] = (i ^ 1u) < count ? (i ^ 1u) : i; }
+};
+
+struct MergeCounts {
+  uint32_t merges = 0;  // pairs merged at this position (the lower one of a pair)
+  uint32_t kept = 0;    // clusters at this position after merging
+};
+
+struct AddMergeCounts {
+  KMBVH_HD MergeCounts operator()(const MergeCounts& a, const MergeCounts& b) const {
+    return {a.merges + b.merges, a.kept + b.kept};
+  }
+};
+
+// i and its nearest neighbour j choose each other (a cluster paired with itself merges with
+// nothing).
+KMBVH_HD KMBVH_INLINE bool mutual_pair(const uint32_t* nearest, uint32_t i, uint32_t j) {
+  return j != i && nearest[j] == i;
+}
+
+struct CountMerges {
+  const uint32_t* nearest;
+  MergeCounts* out;
+
+  KMBVH_HD void operator()(uint32_t i) const {
+    const uint32_t j = nearest[i];
+    const bool mutual = mutual_pair(nearest, i, j);
+    out[i] = {mutual && i < j ? 1u : 0u, mutual && i > j ? 0u : 1u};
+  }
+};
+
+// The lower position of a mutual pair makes the new inner node and keeps it; the higher
+// one drops out. Survivors are written to their compacted positions.
+struct MergeAndCompact {
+  const uint32_t* clusters;
+  BoxColumns cluster_box;
+  const uint32_t* nearest;
+  const MergeCounts* offsets;  // exclusive scan of CountMerges
+  uint32_t first_inner;        // node id of this iteration's first new inner node
+  BinaryTreeView tree;
+  uint32_t* next_clusters;
+  BoxColumns next_box;
+
+  KMBVH_HD void operator()(uint32_t i) const {
+    const uint32_t j = nearest[i];
+    const bool mutual = mutual_pair(nearest, i, j);
+    if (mutual && i > j) return;
+    uint32_t node = clusters[i];
+    Aabb box = cluster_box.get(i);
+    if (mutual) {
+      const uint32_t a = clusters[i], b = clusters[j];
+      node = first_inner + offsets[i].merges;
+      box = join(box, cluster_box.get(j));
+      tree.left[tree.inner(node)] = a;
+      tree.right[tree.inner(node)] = b;
+      tree.parent[a] = node;
+      tree.parent[b] = node;
+      tree.box[node] = box;
+    }
+    next_clusters[offsets[i].kept] = node;
+    next_box.set(offsets[i].kept, box);
+  }
+};
+
+}  // namespace kmbvh
