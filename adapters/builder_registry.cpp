@@ -1,5 +1,6 @@
 #include "builder_registry.h"
 
+#include <embree3/rtcore.h>
 #include <fmt/format.h>
 
 #include <stdexcept>
@@ -78,12 +79,34 @@ std::vector<BuilderConfig> all_builders() {
   return all;
 }
 
+void check_config(const BuilderConfig& config) {
+  EmbreeQuality quality;
+  std::string problem;
+  if (config.builder == "kmeans") {
+    KMeansParams params = config.kmeans;
+    params.max_leaf_size = config.max_leaf_size;
+    problem = check_params(params);
+  } else if (is_binary(config.builder)) {
+    BinaryBuildParams params = config.binary;
+    params.max_leaf_size = config.max_leaf_size;
+    problem = check_params(params);
+  } else if (is_embree(config.builder, &quality)) {
+    if (config.max_leaf_size < 1 || config.max_leaf_size > RTC_BUILD_MAX_PRIMITIVES_PER_LEAF)
+      problem = fmt::format("Embree's leaves hold 1 to {} primitives, got {}", int(RTC_BUILD_MAX_PRIMITIVES_PER_LEAF),
+                            config.max_leaf_size);
+  } else if (config.max_leaf_size < 1) {
+    problem = "the max leaf size must be at least 1";
+  }
+  if (!problem.empty()) throw std::invalid_argument(problem);
+}
+
 void prepare_builder(const BuilderConfig& config) {
   EmbreeQuality quality;
   if (is_embree(config.builder, &quality)) shared_embree_device();
 }
 
 Bvh run_builder(const BuilderConfig& config, const PrimitiveSet& prims, BuildInfo* info) {
+  check_config(config);
   EmbreeQuality quality;
   if (config.builder == "kmeans") {
     KMeansParams params = config.kmeans;

@@ -37,6 +37,10 @@ BuilderConfig parse_builder(const std::string& spec);
 // k-means Q1-Q5, then Embree's.
 std::vector<BuilderConfig> all_builders();
 
+// Throws std::invalid_argument saying what is wrong with the configuration for its builder
+// (each builder's own limits: k-means' k, the binary builders' leaf size, Embree's 32).
+void check_config(const BuilderConfig& config);
+
 // Sets up what the builder needs once per process (Embree's device), so that the first
 // measured build is not charged for it.
 void prepare_builder(const BuilderConfig& config);

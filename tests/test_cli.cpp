@@ -107,6 +107,15 @@ TEST(Cli, BadArgumentsExitWithTwo) {
   EXPECT_EQ(run("build --builder nonsense -q").exit_code, 2);
   EXPECT_EQ(run("build --k 1 -q").exit_code, 2);
   EXPECT_EQ(run("build --preset Q9 -q").exit_code, 2);
+  EXPECT_EQ(run("build --builder lbvh --m 33 -q").exit_code, 2);
+  EXPECT_EQ(run("build --builder embree-low --m 33 -q").exit_code, 2);
+}
+
+TEST(Cli, EachBuilderHasItsOwnLeafLimit) {
+  // k-means takes leaves above the binary builders' 32.
+  const Result r = run("build " + small_obj().string() + " --builder kmeans --m 64 --runs 1 --warmup 0 --json -q");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["params"]["max_leaf_size"], 64);
 }
 
 }  // namespace

@@ -34,8 +34,7 @@ BuilderConfig builder_config(const BuilderOptions& o, const RunOptions& run) {
   config.max_leaf_size = o.max_leaf_size;
   config.backend = backend_of(run);
   config.binary = o.binary;
-  config.binary.max_leaf_size = o.max_leaf_size;
-  if (const std::string problem = check_params(config.binary); !problem.empty()) throw std::invalid_argument(problem);
+  check_config(config);
   if (config.builder != "kmeans") return config;
   const bool custom = (o.k_opt && o.k_opt->count()) || (o.p_opt && o.p_opt->count()) || (o.i_opt && o.i_opt->count());
   if (custom) config.preset.clear();
@@ -47,9 +46,7 @@ BuilderConfig builder_config(const BuilderOptions& o, const RunOptions& run) {
   const auto metric = parse_metric(o.metric);
   if (!metric) throw std::invalid_argument(fmt::format("unknown metric '{}' (means or medians)", o.metric));
   config.kmeans.metric = *metric;
-  config.kmeans.max_leaf_size = o.max_leaf_size;
-  if (const std::string problem = check_params(config.kmeans); !problem.empty())
-    throw std::invalid_argument(problem);
+  check_config(config);
   return config;
 }
 
