@@ -20,14 +20,15 @@ namespace KMBVH_BACKEND_NAMESPACE {
 struct MortonRadixTree {
   uint32_t n = 0;
   Buffer<unsigned long long> codes;
-  Buffer<uint32_t> order, left, right, parent, root;
+  Buffer<uint32_t> order, left, right, parent;
   Buffer<uint32_t> range_first, range_last;  // per inner node, when asked for
   Buffer<Aabb> node_box;
+  uint32_t root = 0;                         // node id, known once the tree is built
 
   BinaryTreeView view() {
     BinaryTreeView t;
     t.n = n;
-    t.root = root.empty() ? 0 : uint32_t(root[0]);
+    t.root = root;
     t.left = ptr(left);
     t.right = ptr(right);
     t.parent = ptr(parent);
@@ -48,12 +49,11 @@ inline void build_morton_radix_tree(const PrimitiveSet& prims, MortonRadixTree& 
   t.right.resize(t.n - 1);
   t.parent.resize(2 * t.n - 1);
   t.node_box.resize(2 * t.n - 1);
-  t.root.resize(1);
-  Buffer<uint32_t> other_end(t.n - 1);
+  Buffer<uint32_t> other_end(t.n - 1), root(1);
   thrust::fill(thrust::device, other_end.begin(), other_end.end(), kNotYet);
   BinaryTreeView tree = t.view();
   for_each_index(t.n, InitLeaves{tree, state.view(), params.sah, boxes.data()});
-  auto build = build_radix_tree(ptr(t.codes), tree, ptr(other_end), ptr(t.root),
+  auto build = build_radix_tree(ptr(t.codes), tree, ptr(other_end), ptr(root),
                                 CollapseNode{tree, state.view(), params.sah, params.max_leaf_size, /*refit=*/true});
   if (with_ranges) {
     t.range_first.resize(t.n - 1);
@@ -62,6 +62,7 @@ inline void build_morton_radix_tree(const PrimitiveSet& prims, MortonRadixTree& 
     build.range_last = ptr(t.range_last);
   }
   for_each_index(t.n, build);
+  t.root = root[0];
   clock.lap("radix tree");
 }
 

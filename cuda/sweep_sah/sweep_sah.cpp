@@ -17,6 +17,7 @@ struct Split {
   uint32_t imbalance = 0;  // |left| - |right|, absolute
   int axis = -1;
   uint32_t position = 0;   // first primitive of the right side, in the axis order
+  Aabb left_box, right_box;  // of the two sides, once the split is chosen
 
   bool better_than(const Split& o) const {
     if (o.axis < 0) return true;
@@ -87,8 +88,8 @@ class SweepBuilder {
         const auto first = uint32_t(bvh.nodes.size());
         const uint32_t left = s.position - p.begin;
         bvh.nodes[p.out] = BvhNode::make_interior(bvh.nodes[p.out].box, first, 2);
-        bvh.nodes.push_back(BvhNode::make_leaf(range_box(s.axis, p.begin, left), p.begin, left));
-        bvh.nodes.push_back(BvhNode::make_leaf(range_box(s.axis, s.position, p.count - left), s.position, p.count - left));
+        bvh.nodes.push_back(BvhNode::make_leaf(s.left_box, p.begin, left));
+        bvh.nodes.push_back(BvhNode::make_leaf(s.right_box, s.position, p.count - left));
         next.push_back({p.begin, left, first});
         next.push_back({s.position, p.count - left, first + 1});
       }
@@ -125,7 +126,9 @@ class SweepBuilder {
     const SahConstants& k = params_.sah;
     const bool leaf = p.count <= params_.max_leaf_size &&
                       k.intersection * p.count * area <= k.traversal * area + k.intersection * best.cost;
-    return leaf ? Split{} : best;
+    if (leaf) return Split{};
+    best.right_box = range_box(best.axis, best.position, p.begin + p.count - best.position);
+    return best;
   }
 
   Split sweep(int a, const PendingNode& p) {
@@ -146,7 +149,10 @@ class SweepBuilder {
       s.imbalance = left > rest ? left - rest : rest - left;
       s.axis = a;
       s.position = i;
-      if (s.better_than(best)) best = s;
+      if (s.better_than(best)) {
+        best = s;
+        best.left_box = acc;
+      }
     }
     return best;
   }

@@ -34,18 +34,19 @@ BuilderConfig builder_config(const BuilderOptions& o, const RunOptions& run) {
   config.max_leaf_size = o.max_leaf_size;
   config.backend = backend_of(run);
   config.binary = o.binary;
-  check_config(config);
-  if (config.builder != "kmeans") return config;
-  const bool custom = (o.k_opt && o.k_opt->count()) || (o.p_opt && o.p_opt->count()) || (o.i_opt && o.i_opt->count());
-  if (custom) config.preset.clear();
-  if (o.k_opt && o.k_opt->count()) config.kmeans.k = o.k;
-  if (o.p_opt && o.p_opt->count()) config.kmeans.p = o.p;
-  if (o.i_opt && o.i_opt->count()) config.kmeans.i = o.i;
-  config.kmeans.seed = o.seed;
-  config.kmeans.wide = o.wide;
-  const auto metric = parse_metric(o.metric);
-  if (!metric) throw std::invalid_argument(fmt::format("unknown metric '{}' (means or medians)", o.metric));
-  config.kmeans.metric = *metric;
+  if (config.builder == "kmeans") {
+    const bool custom =
+        (o.k_opt && o.k_opt->count()) || (o.p_opt && o.p_opt->count()) || (o.i_opt && o.i_opt->count());
+    if (custom) config.preset.clear();
+    if (o.k_opt && o.k_opt->count()) config.kmeans.k = o.k;
+    if (o.p_opt && o.p_opt->count()) config.kmeans.p = o.p;
+    if (o.i_opt && o.i_opt->count()) config.kmeans.i = o.i;
+    config.kmeans.seed = o.seed;
+    config.kmeans.wide = o.wide;
+    const auto metric = parse_metric(o.metric);
+    if (!metric) throw std::invalid_argument(fmt::format("unknown metric '{}' (means or medians)", o.metric));
+    config.kmeans.metric = *metric;
+  }
   check_config(config);
   return config;
 }
