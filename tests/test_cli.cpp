@@ -1,5 +1,5 @@
 // The kmbvh command as a user runs it: JSON fields of `build --json`, the embedded default
-// scene, `bench`, and exit code 2 with a one-line message for a file that cannot be read.
+// scene, `bench`, `trace --compare-embree`, and exit code 2 with a one-line message for a file that cannot be read.
 #include <gtest/gtest.h>
 #include <sys/wait.h>
 
@@ -116,6 +116,39 @@ TEST(Cli, EachBuilderHasItsOwnLeafLimit) {
   const Result r = run("build " + small_obj().string() + " --builder kmeans --m 64 --runs 1 --warmup 0 --json -q");
   ASSERT_EQ(r.exit_code, 0) << r.err;
   EXPECT_EQ(nlohmann::json::parse(r.out)["params"]["max_leaf_size"], 64);
+}
+
+TEST(Cli, TraceComparesWithEmbree) {
+  const Result r = run("trace " + small_obj().string() + " --builder Q2 --layout all --rays all --count 3000 "
+                       "--compare-embree --threads 2 --runs 1 --json -q");
+  ASSERT_EQ(r.exit_code, 0) << r.err << r.out;
+  const auto j = nlohmann::json::parse(r.out);
+  EXPECT_EQ(j["mismatches"], 0);
+  ASSERT_EQ(j["layouts"].size(), 3u);
+  for (const auto& layout : j["layouts"]) {
+    ASSERT_EQ(layout["kinds"].size(), 3u);
+    for (const auto& kind : layout["kinds"]) {
+      EXPECT_EQ(kind["rays"], 3000);
+      EXPECT_GT(kind["kmbvh_mrays_per_s"].get<double>(), 0.0);
+      EXPECT_GT(kind["embree_mrays_per_s"].get<double>(), 0.0);
+      EXPECT_GT(kind["embree16_mrays_per_s"].get<double>(), 0.0);
+      for (const char* field : {"hit_miss", "distance", "primitive", "normal", "barycentrics", "edge_ties", "first"})
+        EXPECT_TRUE(kind["comparison"].contains(field)) << field;
+    }
+  }
+  EXPECT_TRUE(j["layouts"][1]["collapsed"].get<bool>());
+}
+
+TEST(Cli, TraceRejectsAKAryTreeForBvh2) {
+  const Result r = run("trace " + small_obj().string() + " --builder Q2 --wide --layout bvh2 --count 100 -q");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("bvh2"), std::string::npos) << r.err;
+}
+
+TEST(Cli, TraceRejectsAnUnknownLayout) {
+  const Result r = run("trace " + small_obj().string() + " --layout bvh3 --count 100 -q");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("bvh3"), std::string::npos) << r.err;
 }
 
 }  // namespace

@@ -30,4 +30,9 @@ KMBVH_HD KMBVH_INLINE uint32_t counter_uniform(uint32_t seed, uint32_t stream, u
   return static_cast<uint32_t>((static_cast<uint64_t>(counter_hash(seed, stream, index)) * n) >> 32);
 }
 
+// Uniform float in [0, 1), from the top 24 bits of the hash.
+KMBVH_HD KMBVH_INLINE float counter_unit(uint32_t seed, uint32_t stream, uint32_t index) {
+  return static_cast<float>(counter_hash(seed, stream, index) >> 8) * (1.0f / 16777216.0f);
+}
+
 }  // namespace kmbvh

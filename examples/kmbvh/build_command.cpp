@@ -12,18 +12,7 @@ namespace kmbvh {
 void add_build_command(CLI::App& app, BuildCommand& c) {
   CLI::App* cmd = app.add_subcommand("build", "Build a BVH of one scene, measure it and validate it");
   cmd->add_option("scene", c.scene, "glTF/OBJ file or a scene name in $KMBVH_SCENES (default: the embedded scene)");
-  BuilderOptions& b = c.builder;
-  cmd->add_option("--builder", b.builder,
-                  "sweep-sah, lbvh, hlbvh, atrbvh, ploc, kmeans (or Q1..Q5), embree-low, embree-medium, embree-high");
-  cmd->add_option("--preset", b.preset, "k-means preset Q1..Q5 (the paper's)");
-  b.k_opt = cmd->add_option("--k", b.k, "k-means: clusters per node (2..64)");
-  b.p_opt = cmd->add_option("--p", b.p, "k-means: candidates per representative");
-  b.i_opt = cmd->add_option("--i", b.i, "k-means: Lloyd iterations (0 allowed)");
-  cmd->add_option("--m,--max-leaf-size", b.max_leaf_size, "largest leaf");
-  cmd->add_option("--seed", b.seed, "k-means: seed of the counter-based random draws");
-  cmd->add_option("--metric", b.metric, "k-means: means or medians")->check(CLI::IsMember({"means", "medians"}));
-  cmd->add_flag("--wide", b.wide, "k-means: emit the k-ary tree itself instead of binary treelets");
-  add_reference_options(*cmd, b);
+  add_builder_options(*cmd, c.builder);
   add_run_options(*cmd, c.run);
 }
 

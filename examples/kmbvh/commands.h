@@ -10,8 +10,8 @@
 namespace kmbvh {
 
 // Exit codes: 0 done; 1 a build failed; 2 bad input (unreadable file, bad argument);
-// 3 a tree failed validation.
-enum ExitCode { kExitOk = 0, kExitBuildFailed = 1, kExitBadInput = 2, kExitInvalidTree = 3 };
+// 3 a tree failed validation; 4 kmbvh's traversal disagreed with Embree's (`trace`).
+enum ExitCode { kExitOk = 0, kExitBuildFailed = 1, kExitBadInput = 2, kExitInvalidTree = 3, kExitMismatch = 4 };
 
 struct RunOptions {
   int threads = 0;  // 0: every hardware thread
@@ -49,10 +49,24 @@ struct BenchCommand {
   RunOptions run;
 };
 
+struct TraceCommand {
+  std::string scene;
+  BuilderOptions builder;
+  RunOptions run;
+  std::string layouts = "bvh8";  // comma-separated, or "all"
+  std::string rays = "all";      // primary, shadow, diffuse, or all
+  size_t count = 100000;         // rays of each kind
+  uint32_t ray_seed = 7;
+  bool compare_embree = false;
+  size_t show = 5;               // mismatching rays printed in full
+};
+
 void add_build_command(CLI::App& app, BuildCommand& command);
 void add_bench_command(CLI::App& app, BenchCommand& command);
+void add_trace_command(CLI::App& app, TraceCommand& command);
 
 int run_build(const BuildCommand& command);
 int run_bench(const BenchCommand& command);
+int run_trace(const TraceCommand& command);
 
 }  // namespace kmbvh

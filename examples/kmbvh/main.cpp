@@ -1,5 +1,6 @@
 // kmbvh: build BVHs by k-means clustering (Meister and Bittner 2016) and compare them with
-// Embree's. `kmbvh build` runs one builder on one scene; `kmbvh bench` compares several.
+// Embree's. `kmbvh build` runs one builder on one scene; `kmbvh bench` compares several;
+// `kmbvh trace` sends the same rays through kmbvh's traversal and Embree's.
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
@@ -14,8 +15,10 @@ int main(int argc, char** argv) {
   app.require_subcommand(1);
   BuildCommand build;
   BenchCommand bench;
+  TraceCommand trace;
   add_build_command(app, build);
   add_bench_command(app, bench);
+  add_trace_command(app, trace);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -25,6 +28,7 @@ int main(int argc, char** argv) {
 
   try {
     if (app.got_subcommand("build")) return run_build(build);
+    if (app.got_subcommand("trace")) return run_trace(trace);
     return run_bench(bench);
   } catch (const SceneError& e) {
     fmt::print(stderr, "kmbvh: error: {}\n", e.what());

@@ -40,6 +40,7 @@ LoadedScene load_scene_argument(const std::string& argument) {
   if (loaded.dropped)
     fmt::print(stderr, "kmbvh: warning: {}: {} triangles with non-finite vertices left out\n", scene.name,
                loaded.dropped);
+  loaded.geometry = std::move(scene);
   loaded.load_ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
   return loaded;
 }

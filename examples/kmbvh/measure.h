@@ -20,6 +20,7 @@ struct LoadedScene {
   size_t triangles = 0;
   size_t dropped = 0;  // triangles left out (non-finite vertices)
   PrimitiveSet prims;
+  TriangleScene geometry;  // the triangles themselves, for tracing rays
   double load_ms = 0;
 };
 

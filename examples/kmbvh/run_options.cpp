@@ -19,6 +19,20 @@ void add_run_options(CLI::App& cmd, RunOptions& run) {
   cmd.add_flag("-q,--quiet", run.quiet, "no progress on stderr");
 }
 
+void add_builder_options(CLI::App& cmd, BuilderOptions& b) {
+  cmd.add_option("--builder", b.builder,
+                  "sweep-sah, lbvh, hlbvh, atrbvh, ploc, kmeans (or Q1..Q5), embree-low, embree-medium, embree-high");
+  cmd.add_option("--preset", b.preset, "k-means preset Q1..Q5 (the paper's)");
+  b.k_opt = cmd.add_option("--k", b.k, "k-means: clusters per node (2..64)");
+  b.p_opt = cmd.add_option("--p", b.p, "k-means: candidates per representative");
+  b.i_opt = cmd.add_option("--i", b.i, "k-means: Lloyd iterations (0 allowed)");
+  cmd.add_option("--m,--max-leaf-size", b.max_leaf_size, "largest leaf");
+  cmd.add_option("--seed", b.seed, "k-means: seed of the counter-based random draws");
+  cmd.add_option("--metric", b.metric, "k-means: means or medians")->check(CLI::IsMember({"means", "medians"}));
+  cmd.add_flag("--wide", b.wide, "k-means: emit the k-ary tree itself instead of binary treelets");
+  add_reference_options(cmd, b);
+}
+
 void add_reference_options(CLI::App& cmd, BuilderOptions& o) {
   cmd.add_option("--ploc-radius", o.binary.ploc_radius, "PLOC: neighbours searched on each side");
   cmd.add_option("--treelet-size", o.binary.treelet_size, "ATRBVH: leaves of a restructured treelet");

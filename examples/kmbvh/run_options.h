@@ -6,6 +6,8 @@
 namespace kmbvh {
 
 void add_run_options(CLI::App& cmd, RunOptions& run);
+// --builder and every builder's parameters (k-means' and the references').
+void add_builder_options(CLI::App& cmd, BuilderOptions& options);
 // The reference builders' own parameters (PLOC radius, ATRBVH treelets).
 void add_reference_options(CLI::App& cmd, BuilderOptions& options);
 void apply_run_options(const RunOptions& run);

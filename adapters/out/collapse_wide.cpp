@@ -1,0 +1,57 @@
+#include "collapse_wide.h"
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+namespace kmbvh {
+
+uint32_t tree_arity(const Bvh& bvh) {
+  uint32_t arity = 0;
+  for (const BvhNode& n : bvh.nodes)
+    if (!n.is_leaf() && n.count > arity) arity = n.count;
+  return arity;
+}
+
+Bvh collapse_to_width(const Bvh& bvh, uint32_t width) {
+  if (width < 2 || width > 64) throw std::invalid_argument("collapse_to_width: width must be 2..64");
+  if (const uint32_t arity = tree_arity(bvh); arity > width)
+    throw std::invalid_argument("the tree has nodes of " + std::to_string(arity) + " children, more than the layout's " +
+                                std::to_string(width));
+  Bvh out;
+  out.prim_indices = bvh.prim_indices;
+  if (bvh.empty()) return out;
+  out.nodes.push_back(bvh.root());
+  // Breadth-first over the output: (node of bvh, its index in out), children written after it.
+  std::vector<std::pair<uint32_t, uint32_t>> queue{{0, 0}};
+  std::vector<uint32_t> children;
+  for (size_t q = 0; q < queue.size(); ++q) {
+    const auto [from, to] = queue[q];
+    const BvhNode& n = bvh.nodes[from];
+    if (n.is_leaf()) continue;
+    children.clear();
+    for (uint32_t c = 0; c < n.count; ++c) children.push_back(n.first + c);
+    for (;;) {
+      int best = -1;
+      float best_area = -1.0f;
+      for (size_t i = 0; i < children.size(); ++i) {
+        const BvhNode& c = bvh.nodes[children[i]];
+        if (c.is_leaf() || children.size() - 1 + c.count > width) continue;
+        if (const float a = c.box.surface_area(); a > best_area) best_area = a, best = int(i);
+      }
+      if (best < 0) break;
+      const BvhNode& opened = bvh.nodes[children[best]];
+      children.erase(children.begin() + best);
+      for (uint32_t c = 0; c < opened.count; ++c) children.push_back(opened.first + c);
+    }
+    const uint32_t first = uint32_t(out.nodes.size());
+    out.nodes[to] = BvhNode::make_interior(n.box, first, uint32_t(children.size()));
+    for (const uint32_t c : children) {
+      queue.push_back({c, uint32_t(out.nodes.size())});
+      out.nodes.push_back(bvh.nodes[c]);  // a leaf stays as it is; an interior node is rewritten when dequeued
+    }
+  }
+  return out;
+}
+
+}  // namespace kmbvh

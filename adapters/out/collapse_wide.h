@@ -1,0 +1,21 @@
+// A binary (or any narrow) tree made wide for SIMD traversal: each wide node takes its
+// children and keeps opening the interior child of largest surface area (the child a ray
+// is most likely to enter, so opening it removes the most expected box tests: the
+// greedy SAH collapse Embree's BVH4 and BVH8 builders also use) while the children fit in
+// `width`. Leaves and their primitives are kept as they are.
+#pragma once
+
+#include <cstdint>
+
+#include "cuda/core/bvh.h"
+
+namespace kmbvh {
+
+// Returns a tree whose nodes have at most `width` children (2 <= width <= 64).
+// Throws std::invalid_argument if a node of `bvh` already has more.
+Bvh collapse_to_width(const Bvh& bvh, uint32_t width);
+
+// The largest number of children of any node.
+uint32_t tree_arity(const Bvh& bvh);
+
+}  // namespace kmbvh

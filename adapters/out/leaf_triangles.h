@@ -1,0 +1,22 @@
+// The triangles of a tree in leaf order, shared by every traversal layout: entry j is the
+// triangle of bvh.prim_indices[j], so a leaf's triangles are one contiguous range. A
+// degenerate triangle (is_degenerate_triangle) is stored with NaN vertices: never hit.
+#pragma once
+
+#include <vector>
+
+#include "adapters/in/triangle_scene.h"
+#include "cuda/core/bvh.h"
+#include "cuda/traversal/bvh2.h"
+
+namespace kmbvh {
+
+struct LeafTriangles {
+  std::vector<LeafTriangle> triangles;
+  std::vector<PrimitiveId> ids;
+};
+
+// prims: the set the tree was built over (made from `scene` by make_primitive_set).
+LeafTriangles leaf_triangles(const Bvh& bvh, const PrimitiveSet& prims, const TriangleScene& scene);
+
+}  // namespace kmbvh

@@ -1,0 +1,28 @@
+// Rays through a 4- or 8-wide layout on the CPU: every child box of a node in one SIMD
+// slab test (AVX2 for 8 lanes and SSE for 4 when the build targets x86-64-v3; GCC's
+// vector extensions split or widen as the target allows), then the entered children
+// ordered by distance, nearest first. Same ray conventions and triangle test as the
+// portable BVH2 kernel (cuda/traversal), so every layout gives the same answer.
+#pragma once
+
+#include <vector>
+
+#include "cuda/traversal/ray.h"
+#include "wide_bvh.h"
+
+namespace kmbvh {
+
+// hits[i] answers rays[i] (Query::Any: found() means occluded); split across threads.
+template <int W>
+void trace_wide(const WideBvh<W>& bvh, const std::vector<Ray>& rays, Query query, std::vector<Hit>& hits);
+
+struct WideEntry {
+  uint32_t ref, count;  // as in WideNode: count 0 is an interior node
+  float entry;          // where the ray enters its box: skipped once a closer hit is known
+};
+
+// One ray; `stack` holds bvh.stack_size entries.
+template <int W>
+bool trace_wide_ray(const WideBvh<W>& bvh, const Ray& ray, Query query, WideEntry* stack, Hit& hit);
+
+}  // namespace kmbvh

@@ -1,0 +1,88 @@
+#include "tracer.h"
+
+#include <chrono>
+#include <stdexcept>
+
+#include "bvh2_layout.h"
+#include "collapse_wide.h"
+#include "trace_wide.h"
+#include "wide_bvh.h"
+
+namespace kmbvh {
+
+struct Tracer::Layouts {
+  Bvh2 bvh2;
+  WideBvh<4> bvh4;
+  WideBvh<8> bvh8;
+};
+
+const char* to_string(Layout layout) {
+  switch (layout) {
+    case Layout::Bvh2: return "bvh2";
+    case Layout::Bvh4: return "bvh4";
+    case Layout::Bvh8: return "bvh8";
+  }
+  return "?";
+}
+
+Layout parse_layout(const std::string& name) {
+  for (Layout l : {Layout::Bvh2, Layout::Bvh4, Layout::Bvh8})
+    if (name == to_string(l)) return l;
+  throw std::invalid_argument("unknown layout '" + name + "' (bvh2, bvh4 or bvh8)");
+}
+
+uint32_t layout_width(Layout layout) { return layout == Layout::Bvh2 ? 2 : layout == Layout::Bvh4 ? 4 : 8; }
+
+Tracer::Tracer(const Bvh& bvh, const PrimitiveSet& prims, const TriangleScene& scene, Layout layout, Backend backend)
+    : layout_(layout), backend_(backend), layouts_(std::make_unique<Layouts>()) {
+  if (backend == Backend::Cuda && layout != Layout::Bvh2)
+    throw std::invalid_argument("the CUDA traversal reads the bvh2 layout; bvh4 and bvh8 are CPU SIMD layouts");
+  require_backend(backend);
+  const auto start = std::chrono::steady_clock::now();
+  const uint32_t width = layout_width(layout);
+  const uint32_t arity = tree_arity(bvh);
+  if (arity > width)
+    throw std::invalid_argument("a " + std::string(to_string(layout)) + " layout needs nodes of at most " +
+                                std::to_string(width) + " children; this tree has " + std::to_string(arity));
+  collapsed_ = layout != Layout::Bvh2 && arity <= 2;
+  tree_ = collapsed_ ? collapse_to_width(bvh, width) : bvh;
+  LeafTriangles triangles = leaf_triangles(tree_, prims, scene);
+  switch (layout) {
+    case Layout::Bvh2: layouts_->bvh2 = make_bvh2(tree_, std::move(triangles)); break;
+    case Layout::Bvh4: layouts_->bvh4 = make_wide_bvh<4>(tree_, std::move(triangles)); break;
+    case Layout::Bvh8: layouts_->bvh8 = make_wide_bvh<8>(tree_, std::move(triangles)); break;
+  }
+  layout_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+Tracer::~Tracer() = default;
+Tracer::Tracer(Tracer&&) noexcept = default;
+
+void Tracer::trace(const std::vector<Ray>& rays, Query query, std::vector<Hit>& hits) const {
+  switch (layout_) {
+    case Layout::Bvh2: return trace_bvh2(layouts_->bvh2, rays, query, hits, backend_);
+    case Layout::Bvh4: return trace_wide(layouts_->bvh4, rays, query, hits);
+    case Layout::Bvh8: return trace_wide(layouts_->bvh8, rays, query, hits);
+  }
+}
+
+size_t Tracer::layout_bytes() const {
+  const auto tri_bytes = [](size_t n) { return n * (sizeof(LeafTriangle) + sizeof(PrimitiveId)); };
+  switch (layout_) {
+    case Layout::Bvh2: return layouts_->bvh2.nodes.size() * sizeof(Bvh2Node) + tri_bytes(layouts_->bvh2.triangles.size());
+    case Layout::Bvh4: return layouts_->bvh4.nodes.size() * sizeof(WideNode<4>) + tri_bytes(layouts_->bvh4.triangles.size());
+    case Layout::Bvh8: return layouts_->bvh8.nodes.size() * sizeof(WideNode<8>) + tri_bytes(layouts_->bvh8.triangles.size());
+  }
+  return 0;
+}
+
+uint32_t Tracer::stack_size() const {
+  switch (layout_) {
+    case Layout::Bvh2: return layouts_->bvh2.stack_size;
+    case Layout::Bvh4: return layouts_->bvh4.stack_size;
+    case Layout::Bvh8: return layouts_->bvh8.stack_size;
+  }
+  return 0;
+}
+
+}  // namespace kmbvh

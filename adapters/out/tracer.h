@@ -1,0 +1,53 @@
+// kmbvh's traversal behind one call, for any builder's tree and any layout: the tree is
+// laid out once (BVH2 for the portable kernel; 4- or 8-wide for SIMD on the CPU, either
+// collapsed from a binary tree or taken as the k-means builder made it k-ary), then
+// traces batches of rays.
+#pragma once
+
+#include <memory>
+#include <string>
+#include <vector>
+
+#include "adapters/in/triangle_scene.h"
+#include "cuda/core/backend.h"
+#include "cuda/core/bvh.h"
+#include "cuda/traversal/ray.h"
+
+namespace kmbvh {
+
+enum class Layout { Bvh2, Bvh4, Bvh8 };
+const char* to_string(Layout layout);
+// "bvh2", "bvh4" or "bvh8"; throws std::invalid_argument otherwise.
+Layout parse_layout(const std::string& name);
+uint32_t layout_width(Layout layout);
+
+class Tracer {
+ public:
+  // prims: the set `bvh` was built over, made from `scene`. A binary tree is collapsed for
+  // the wide layouts; a k-ary tree (k-means --wide) is laid out as built, so its arity must
+  // not exceed the layout's width. Throws std::invalid_argument when it cannot be laid out.
+  Tracer(const Bvh& bvh, const PrimitiveSet& prims, const TriangleScene& scene, Layout layout,
+         Backend backend = Backend::Cpu);
+  ~Tracer();
+  Tracer(Tracer&&) noexcept;
+
+  void trace(const std::vector<Ray>& rays, Query query, std::vector<Hit>& hits) const;
+
+  Layout layout() const { return layout_; }
+  const Bvh& traced_tree() const { return tree_; }  // the tree as laid out (after any collapse)
+  bool collapsed() const { return collapsed_; }
+  double layout_ms() const { return layout_ms_; }
+  size_t layout_bytes() const;
+  uint32_t stack_size() const;
+
+ private:
+  struct Layouts;
+  Layout layout_;
+  Backend backend_;
+  Bvh tree_;
+  bool collapsed_ = false;
+  double layout_ms_ = 0;
+  std::unique_ptr<Layouts> layouts_;
+};
+
+}  // namespace kmbvh

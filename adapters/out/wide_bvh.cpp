@@ -1,0 +1,79 @@
+#include "wide_bvh.h"
+
+#include <algorithm>
+#include <cfloat>
+#include <stdexcept>
+#include <string>
+#include <utility>
+
+namespace kmbvh {
+namespace {
+
+template <int W>
+WideNode<W> empty_node() {
+  WideNode<W> n;
+  for (int i = 0; i < W; ++i) {
+    for (int d = 0; d < 3; ++d) {
+      n.lo[d][i] = FLT_MAX;
+      n.hi[d][i] = -FLT_MAX;
+    }
+    n.ref[i] = 0;
+    n.count[i] = 1;  // an empty lane is never entered; if it were, it would read as a leaf, not a loop
+  }
+  return n;
+}
+
+template <int W>
+void set_lane(WideNode<W>& out, int lane, const BvhNode& n, uint32_t ref) {
+  if (n.is_leaf() && n.count == 0) return;  // the empty set's leaf: leave the lane empty
+  for (int d = 0; d < 3; ++d) {
+    out.lo[d][lane] = n.box.lo[d];
+    out.hi[d][lane] = n.box.hi[d];
+  }
+  out.ref[lane] = n.is_leaf() ? n.first : ref;
+  out.count[lane] = n.is_leaf() ? n.count : 0;
+}
+
+}  // namespace
+
+template <int W>
+WideBvh<W> make_wide_bvh(const Bvh& bvh, LeafTriangles triangles) {
+  WideBvh<W> out;
+  out.triangles = std::move(triangles.triangles);
+  out.ids = std::move(triangles.ids);
+  if (bvh.empty() || (bvh.root().is_leaf() && bvh.root().count == 0)) return out;
+  if (bvh.root().is_leaf()) {  // one leaf: a root with a single lane
+    out.nodes.push_back(empty_node<W>());
+    set_lane(out.nodes[0], 0, bvh.root(), 0);
+    return out;
+  }
+  struct Pending {
+    uint32_t bvh_node, parent, lane, depth;
+  };
+  std::vector<Pending> stack{{0, UINT32_MAX, 0, 1}};
+  uint32_t max_depth = 1;
+  while (!stack.empty()) {
+    const Pending p = stack.back();
+    stack.pop_back();
+    const BvhNode& n = bvh.nodes[p.bvh_node];
+    if (n.count > W)
+      throw std::invalid_argument("a " + std::to_string(W) + "-wide layout got a node of " + std::to_string(n.count) +
+                                  " children");
+    const uint32_t index = uint32_t(out.nodes.size());
+    out.nodes.push_back(empty_node<W>());
+    if (p.parent != UINT32_MAX) out.nodes[p.parent].ref[p.lane] = index;
+    max_depth = std::max(max_depth, p.depth);
+    for (int c = int(n.count) - 1; c >= 0; --c) {
+      const BvhNode& child = bvh.nodes[n.first + c];
+      set_lane(out.nodes[index], c, child, 0);
+      if (!child.is_leaf()) stack.push_back({n.first + uint32_t(c), index, uint32_t(c), p.depth + 1});
+    }
+  }
+  out.stack_size = (W - 1) * max_depth + 1;
+  return out;
+}
+
+template WideBvh<4> make_wide_bvh<4>(const Bvh&, LeafTriangles);
+template WideBvh<8> make_wide_bvh<8>(const Bvh&, LeafTriangles);
+
+}  // namespace kmbvh

@@ -1,0 +1,36 @@
+// 4- and 8-wide node layouts for SIMD traversal on the CPU: one node holds the boxes of
+// all its children as structure-of-arrays (lo and hi per axis, W lanes each), so one ray
+// tests every child box with a handful of vector instructions. Unused lanes hold an empty
+// box (lo = +max, hi = -max), which the slab test never enters.
+#pragma once
+
+#include <cstdint>
+#include <vector>
+
+#include "cuda/core/bvh.h"
+#include "leaf_triangles.h"
+
+namespace kmbvh {
+
+template <int W>
+struct alignas(64) WideNode {
+  float lo[3][W];
+  float hi[3][W];
+  uint32_t ref[W];    // interior child: its node index; leaf child: its first triangle
+  uint32_t count[W];  // 0 for an interior child; the leaf's triangle count otherwise
+};
+
+template <int W>
+struct WideBvh {
+  std::vector<WideNode<W>> nodes;  // nodes[0] is the root; empty for an empty scene
+  std::vector<LeafTriangle> triangles;
+  std::vector<PrimitiveId> ids;
+  uint32_t stack_size = 1;  // bounds the traversal stack: (W - 1) per level, plus one
+};
+
+// Lays out a tree of at most W children per node (collapse_to_width makes one from any
+// binary tree). Throws std::invalid_argument for a node with more.
+template <int W>
+WideBvh<W> make_wide_bvh(const Bvh& bvh, LeafTriangles triangles);
+
+}  // namespace kmbvh

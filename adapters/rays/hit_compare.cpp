@@ -1,0 +1,172 @@
+#include "hit_compare.h"
+
+#include <algorithm>
+#include <cmath>
+#include <limits>
+
+namespace kmbvh {
+namespace {
+
+constexpr double kEdge = 1e-5;      // barycentric distance to an edge that counts as "on it"
+constexpr double kRelT = 1e-5;      // relative tolerance on t
+constexpr float kRelNormal = 1e-4f;
+constexpr float kBarycentric = 1e-4f;
+
+struct D3 {
+  double x, y, z;
+};
+D3 d3(Vec3 v) { return {v.x, v.y, v.z}; }
+D3 sub(D3 a, D3 b) { return {a.x - b.x, a.y - b.y, a.z - b.z}; }
+D3 cross(D3 a, D3 b) { return {a.y * b.z - a.z * b.y, a.z * b.x - a.x * b.z, a.x * b.y - a.y * b.x}; }
+double dot(D3 a, D3 b) { return a.x * b.x + a.y * b.y + a.z * b.z; }
+
+// Float coordinates fix the precision of a hit point, so t is compared relative to the
+// larger of the distance travelled and the origin's own magnitude (over |dir|): a hit a
+// hair from an origin far from zero is only known to that origin's precision.
+double t_scale(const Ray& ray, double t) {
+  const double o = std::max({std::fabs(ray.org.x), std::fabs(ray.org.y), std::fabs(ray.org.z)});
+  const double d = std::sqrt(double(dot(ray.dir, ray.dir)));
+  return std::max(std::fabs(t), d > 0 ? o / d : 0.0);
+}
+// How the ray meets one triangle, in double precision: not at all, on an edge or an end
+// of the interval (within tolerance: rounding decides), or clearly.
+enum class Meet { None, Edge, Clear };
+
+Meet meet(const TriangleScene& scene, uint32_t prim, const Ray& ray, double& t, double* uv = nullptr) {
+  const Triangle& tri = scene.triangles[prim];
+  const D3 a = d3(scene.positions[tri[0]]), b = d3(scene.positions[tri[1]]), c = d3(scene.positions[tri[2]]);
+  const D3 o = d3(ray.org), d = d3(ray.dir);
+  const D3 e1 = sub(b, a), e2 = sub(c, a), p = cross(d, e2);
+  const double det = dot(e1, p);
+  if (det == 0.0 || !std::isfinite(det)) return Meet::None;
+  const D3 s = sub(o, a), q = cross(s, e1);
+  const double u = dot(s, p) / det, v = dot(d, q) / det, w = 1.0 - u - v;
+  t = dot(e2, q) / det;
+  if (uv) uv[0] = u, uv[1] = v;
+  const double lo = ray.tnear, hi = ray.tfar, slack = kRelT * std::max(t_scale(ray, t), 1e-30);
+  if (u < -kEdge || v < -kEdge || w < -kEdge || t <= lo - slack || t > hi + slack) return Meet::None;
+  const bool clear = u > kEdge && v > kEdge && w > kEdge && t > lo + slack && t <= hi - slack;
+  return clear ? Meet::Clear : Meet::Edge;
+}
+
+struct Ground {
+  double nearest_clear = std::numeric_limits<double>::infinity();
+  bool any = false;  // a hit, on an edge or clear
+};
+
+Ground brute_force(const TriangleScene& scene, const Ray& ray) {
+  Ground g;
+  for (uint32_t p = 0; p < scene.triangles.size(); ++p) {
+    double t;
+    const Meet m = meet(scene, p, ray, t);
+    if (m == Meet::None) continue;
+    g.any = true;
+    if (m == Meet::Clear) g.nearest_clear = std::min(g.nearest_clear, t);
+  }
+  return g;
+}
+
+bool same_t(const Ray& ray, double a, double b) { return std::fabs(a - b) <= kRelT * t_scale(ray, std::max(a, b)); }
+
+// Whether an answer is right up to rounding: a miss only if nothing is clearly hit; a hit
+// only on a triangle the ray meets there, with nothing clearly hit before it.
+bool acceptable(const TriangleScene& scene, const Ray& ray, Query query, const Hit& h, const Ground& g) {
+  if (!h.found()) return !std::isfinite(g.nearest_clear);
+  if (query == Query::Any) return g.any;
+  if (h.primID >= scene.triangles.size()) return false;
+  double t;
+  if (meet(scene, h.primID, ray, t) == Meet::None || !same_t(ray, t, h.t)) return false;
+  return !(g.nearest_clear < h.t - kRelT * t_scale(ray, h.t));
+}
+
+// Whether the ray meets the hit's triangle (on an edge or clearly) where the hit says.
+bool meets_at(const TriangleScene& scene, const Ray& ray, const Hit& h) {
+  double t;
+  return h.primID < scene.triangles.size() && meet(scene, h.primID, ray, t) != Meet::None && same_t(ray, t, h.t);
+}
+
+bool normals_differ(Vec3 a, Vec3 b) {
+  const float scale = std::max({std::fabs(b.x), std::fabs(b.y), std::fabs(b.z), 1e-30f});
+  return std::fabs(a.x - b.x) > kRelNormal * scale || std::fabs(a.y - b.y) > kRelNormal * scale ||
+         std::fabs(a.z - b.z) > kRelNormal * scale;
+}
+
+}  // namespace
+
+void HitComparison::add(const HitComparison& o, size_t keep) {
+  rays += o.rays;
+  hits += o.hits;
+  skipped += o.skipped;
+  hit_miss += o.hit_miss;
+  distance += o.distance;
+  primitive += o.primitive;
+  normal += o.normal;
+  barycentrics += o.barycentrics;
+  edge_ties += o.edge_ties;
+  embree_imprecise += o.embree_imprecise;
+  for (const RayMismatch& m : o.first)
+    if (first.size() < keep) first.push_back(m);
+}
+
+HitComparison compare_hits(const TriangleScene& scene, const std::vector<Ray>& rays, Query query,
+                           const std::vector<Hit>& ours, const std::vector<Hit>& reference, size_t keep) {
+  HitComparison out;
+  out.rays = rays.size();
+  for (size_t i = 0; i < rays.size(); ++i) {
+    const Ray& ray = rays[i];
+    const Hit& a = ours[i];
+    const Hit& b = reference[i];
+    out.hits += b.found();
+    if (!ray_is_valid(ray)) ++out.skipped;
+    const char* kind = nullptr;
+    if (a.found() != b.found()) {
+      kind = "hit_miss";
+    } else if (a.found() && query == Query::Closest) {
+      if (!same_t(ray, a.t, b.t))
+        kind = "distance";
+      else if (a.geomID != b.geomID || a.primID != b.primID)
+        kind = "primitive";
+      else if (normals_differ(a.Ng, b.Ng))
+        kind = "normal";
+      else if (std::fabs(a.u - b.u) > kBarycentric || std::fabs(a.v - b.v) > kBarycentric)
+        kind = "barycentrics";
+    }
+    if (!kind) continue;
+    const bool same_prim = a.found() && b.found() && a.geomID == b.geomID && a.primID == b.primID;
+    if (same_prim && kind[0] != 'n' && a.primID < scene.triangles.size()) {
+      // Same triangle, numbers apart: whose are right? Embree's float t, u, v drift on
+      // thin triangles seen edge-on; kmbvh's are refined in double precision.
+      double t, uv[2];
+      meet(scene, a.primID, ray, t, uv);
+      if (same_t(ray, a.t, t) && std::fabs(a.u - uv[0]) <= kBarycentric && std::fabs(a.v - uv[1]) <= kBarycentric) {
+        ++out.embree_imprecise;
+        continue;
+      }
+    }
+    if (kind[0] == 'p' && meets_at(scene, ray, a) && meets_at(scene, ray, b)) {
+      // Both found a triangle at the same distance (a shared edge or vertex, or coplanar
+      // overlapping faces): two independent systems agree on the distance, so either
+      // primitive is right, without a brute-force search for a nearer one.
+      ++out.edge_ties;
+      continue;
+    }
+    const bool geometric = !same_prim && (kind[0] == 'h' || kind[0] == 'd');
+    if (geometric && ray_is_valid(ray)) {
+      const Ground g = brute_force(scene, ray);
+      if (acceptable(scene, ray, query, a, g) && acceptable(scene, ray, query, b, g)) {
+        ++out.edge_ties;
+        continue;
+      }
+    }
+    const std::string k = kind;
+    if (k == "hit_miss") ++out.hit_miss;
+    else if (k == "distance") ++out.distance;
+    else if (k == "primitive") ++out.primitive;
+    else if (k == "normal") ++out.normal;
+    else ++out.barycentrics;
+    if (out.first.size() < keep) out.first.push_back(RayMismatch{i, k, ray, a, b});
+  }
+  return out;
+}
+
+}  // namespace kmbvh

@@ -1,0 +1,35 @@
+// Many rays through a Bvh2 at once: the batch entry of the portable traversal kernel, on
+// the CPU (OpenMP threads, each with its own stack) or the GPU (one thread per ray).
+#pragma once
+
+#include <vector>
+
+#include "bvh2.h"
+#include "cuda/core/backend.h"
+#include "ray.h"
+
+namespace kmbvh {
+
+// A Bvh2 in host memory, owning its arrays (adapters/out/bvh2_layout.h makes one).
+struct Bvh2 {
+  std::vector<Bvh2Node> nodes;
+  std::vector<LeafTriangle> triangles;
+  std::vector<PrimitiveId> ids;
+  uint32_t stack_size = 1;
+
+  Bvh2View view() const {
+    return Bvh2View{nodes.data(), triangles.data(), ids.data(), uint32_t(nodes.size()), stack_size};
+  }
+};
+
+// hits[i] answers rays[i]: the closest hit, or for Query::Any any hit (found() means
+// occluded). Throws std::runtime_error when the backend cannot run here.
+void trace_bvh2(const Bvh2& bvh, const std::vector<Ray>& rays, Query query, std::vector<Hit>& hits,
+                Backend backend = Backend::Cpu);
+
+namespace detail {
+void trace_bvh2_cpu(const Bvh2View& view, const Ray* rays, size_t n, Query query, Hit* hits);
+void trace_bvh2_gpu(const Bvh2& bvh, const Ray* rays, size_t n, Query query, Hit* hits);
+}  // namespace detail
+
+}  // namespace kmbvh

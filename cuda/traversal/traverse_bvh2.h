@@ -1,0 +1,82 @@
+// One ray through a Bvh2: the while-while loop of Aila and Laine (2009). The inner loop
+// walks interior nodes, entering the nearer child and pushing the farther one, until it
+// reaches a leaf; the second loop intersects leaves until the next interior node comes
+// off the stack. Written once for the CPU and the GPU (DESIGN.md §3).
+//
+// The stack grows by at most one entry per level (only the farther child of a node is
+// pushed), so the layout's stack_size, the depth of the tree plus one, always suffices:
+// a deep tree needs a bigger stack, never a lucky ray.
+#pragma once
+
+#include "bvh2.h"
+#include "ray_box.h"
+#include "watertight.h"
+
+namespace kmbvh {
+
+struct TraversalEntry {
+  uint32_t ref, count;  // as in Bvh2Node: count 0 is an interior node
+  float entry;          // where the ray enters its box: skipped once a closer hit is known
+};
+
+KMBVH_HD KMBVH_INLINE bool finish_bvh2_hit(const Bvh2View& view, const Ray& ray, uint32_t found, Hit& hit) {
+  if (found == kInvalidId) return false;
+  const LeafTriangle& tri = view.triangles[found];
+  refine_hit(ray, tri.a, tri.b, tri.c, hit);
+  hit.geomID = view.ids[found].geom;
+  hit.primID = view.ids[found].prim;
+  return true;
+}
+
+// Closest hit (query Closest) or any hit (query Any) within [ray.tnear, ray.tfar].
+// `stack` holds view.stack_size entries. Returns whether a hit was found; for Closest,
+// `hit` holds it.
+KMBVH_HD KMBVH_INLINE bool trace_bvh2(const Bvh2View& view, const Ray& ray, Query query, TraversalEntry* stack,
+                                      Hit& hit) {
+  hit = Hit();
+  if (view.node_count == 0 || !ray_is_valid(ray) || !(ray.tnear <= ray.tfar)) return false;
+  if (ray.dir.x == 0.0f && ray.dir.y == 0.0f && ray.dir.z == 0.0f) return false;
+  const RayBoxSetup boxes(ray);
+  const RayShear shear(ray);
+  float tmax = ray.tfar;
+  uint32_t found = kInvalidId;  // the closest hit's triangle so far
+  uint32_t sp = 0;
+  TraversalEntry cur{0, 0, ray.tnear};
+  for (;;) {
+    while (cur.count == 0) {  // interior nodes
+      const Bvh2Node& n = view.nodes[cur.ref];
+      float e0, e1;
+      const bool h0 = ray_enters_box(boxes, n.box[0], ray.tnear, tmax, e0);
+      const bool h1 = ray_enters_box(boxes, n.box[1], ray.tnear, tmax, e1);
+      if (h0 && h1) {
+        const int near = e1 < e0 ? 1 : 0;
+        stack[sp++] = TraversalEntry{n.ref[1 - near], n.count[1 - near], near ? e0 : e1};
+        cur = TraversalEntry{n.ref[near], n.count[near], near ? e1 : e0};
+      } else if (h0 || h1) {
+        const int c = h1 ? 1 : 0;
+        cur = TraversalEntry{n.ref[c], n.count[c], c ? e1 : e0};
+      } else {
+        do {
+          if (sp == 0) return finish_bvh2_hit(view, ray, found, hit);
+          cur = stack[--sp];
+        } while (cur.entry > tmax);
+      }
+    }
+    while (cur.count != 0) {  // leaves
+      for (uint32_t i = cur.ref; i < cur.ref + cur.count; ++i) {
+        const LeafTriangle& tri = view.triangles[i];
+        if (!intersect_watertight(shear, ray.tnear, tmax, tri.a, tri.b, tri.c, hit)) continue;
+        found = i;
+        if (query == Query::Any) break;
+        tmax = hit.t;
+      }
+      if (query == Query::Any && found != kInvalidId) return finish_bvh2_hit(view, ray, found, hit);
+      do {
+        if (sp == 0) return finish_bvh2_hit(view, ray, found, hit);
+        cur = stack[--sp];
+      } while (cur.entry > tmax);
+    }
+  }
+}
+
+}  // namespace kmbvh

@@ -1,0 +1,99 @@
+// The watertight ray-triangle test of Woop, Benthin and Wald ("Watertight Ray/Triangle
+// Intersection", JCGT 2013): vertices are moved into a space where the ray runs along +z
+// from the origin, and the 2D edge functions decide inside or outside. A ray through a
+// shared edge or vertex hits at least one of the triangles, never slips between them;
+// edge functions that come out exactly zero are redone in double precision, as the paper
+// prescribes. Degenerate (zero-area) triangles have a zero determinant and are never hit.
+#pragma once
+
+#include "ray.h"
+
+namespace kmbvh {
+
+// Per-ray set-up of the shear, done once per ray rather than once per triangle.
+struct RayShear {
+  Vec3 org;
+  int kx = 0, ky = 1, kz = 2;
+  float sx = 0, sy = 0, sz = 1;
+
+  KMBVH_HD explicit RayShear(const Ray& ray) : org(ray.org) {
+    const float ax = ray.dir.x < 0 ? -ray.dir.x : ray.dir.x;
+    const float ay = ray.dir.y < 0 ? -ray.dir.y : ray.dir.y;
+    const float az = ray.dir.z < 0 ? -ray.dir.z : ray.dir.z;
+    kz = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
+    kx = kz == 2 ? 0 : kz + 1;
+    ky = kx == 2 ? 0 : kx + 1;
+    if (ray.dir[kz] < 0.0f) {  // keep the winding, so the sign of the determinant means what it says
+      const int k = kx;
+      kx = ky;
+      ky = k;
+    }
+    sz = 1.0f / ray.dir[kz];
+    sx = ray.dir[kx] * sz;
+    sy = ray.dir[ky] * sz;
+  }
+};
+
+// A triangle Embree never hits: its geometric normal, computed in float, is exactly zero
+// (a point, a repeated vertex, collinear vertices). The shear of the watertight test can
+// round such a triangle into a sliver that a ray hits, so layouts store it with NaN
+// vertices, which fail every comparison of the test below.
+KMBVH_HD KMBVH_INLINE bool is_degenerate_triangle(Vec3 a, Vec3 b, Vec3 c) {
+  const Vec3 n = cross(b - a, c - a);
+  return n.x == 0.0f && n.y == 0.0f && n.z == 0.0f;
+}
+
+// Tests the ray against triangle (a, b, c) for tnear < t <= tmax. On a hit, fills t, u, v
+// and the geometric normal; leaves the ids to the caller.
+KMBVH_HD KMBVH_INLINE bool intersect_watertight(const RayShear& s, float tnear, float tmax, Vec3 a, Vec3 b,
+                                                Vec3 c, Hit& hit) {
+  const Vec3 A = a - s.org, B = b - s.org, C = c - s.org;
+  const float ax = A[s.kx] - s.sx * A[s.kz], ay = A[s.ky] - s.sy * A[s.kz];
+  const float bx = B[s.kx] - s.sx * B[s.kz], by = B[s.ky] - s.sy * B[s.kz];
+  const float cx = C[s.kx] - s.sx * C[s.kz], cy = C[s.ky] - s.sy * C[s.kz];
+  float U = cx * by - cy * bx;
+  float V = ax * cy - ay * cx;
+  float W = bx * ay - by * ax;
+  if (U == 0.0f || V == 0.0f || W == 0.0f) {
+    U = float(double(cx) * double(by) - double(cy) * double(bx));
+    V = float(double(ax) * double(cy) - double(ay) * double(cx));
+    W = float(double(bx) * double(ay) - double(by) * double(ax));
+  }
+  if ((U < 0.0f || V < 0.0f || W < 0.0f) && (U > 0.0f || V > 0.0f || W > 0.0f)) return false;
+  const float det = U + V + W;
+  if (det == 0.0f) return false;
+  const float az = s.sz * A[s.kz], bz = s.sz * B[s.kz], cz = s.sz * C[s.kz];
+  const float T = U * az + V * bz + W * cz;
+  // t = T / det must lie in (tnear, tmax]; compared before dividing, with det's sign.
+  const float abs_det = det < 0.0f ? -det : det;
+  const float abs_T = det < 0.0f ? -T : T;
+  if (!(abs_T > tnear * abs_det) || !(abs_T <= tmax * abs_det)) return false;
+  const float inv = 1.0f / det;
+  hit.t = T * inv;
+  hit.u = V * inv;
+  hit.v = W * inv;
+  hit.Ng = cross(b - a, c - a);
+  return true;
+}
+
+// The watertight test decides hit or miss, but its sheared, origin-relative coordinates
+// lose digits of t, u and v when the triangle is thin and seen almost edge-on from far
+// away (a wall across a room: u off by 1e-3 in float, by any float method; Embree's too).
+// So the closest hit, once known, is measured again from the triangle's own edges in
+// double precision: one more test per ray, and t, u, v correct to float precision.
+KMBVH_HD KMBVH_INLINE void refine_hit(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, Hit& hit) {
+  const double e1x = double(b.x) - a.x, e1y = double(b.y) - a.y, e1z = double(b.z) - a.z;
+  const double e2x = double(c.x) - a.x, e2y = double(c.y) - a.y, e2z = double(c.z) - a.z;
+  const double dx = ray.dir.x, dy = ray.dir.y, dz = ray.dir.z;
+  const double px = dy * e2z - dz * e2y, py = dz * e2x - dx * e2z, pz = dx * e2y - dy * e2x;
+  const double det = e1x * px + e1y * py + e1z * pz;
+  if (det == 0.0) return;
+  const double sx = double(ray.org.x) - a.x, sy = double(ray.org.y) - a.y, sz = double(ray.org.z) - a.z;
+  const double qx = sy * e1z - sz * e1y, qy = sz * e1x - sx * e1z, qz = sx * e1y - sy * e1x;
+  const double inv = 1.0 / det;
+  hit.u = float((sx * px + sy * py + sz * pz) * inv);
+  hit.v = float((dx * qx + dy * qy + dz * qz) * inv);
+  hit.t = float((e2x * qx + e2y * qy + e2z * qz) * inv);
+}
+
+}  // namespace kmbvh

@@ -1,0 +1,247 @@
+// kmbvh trace SCENE --builder B --layout L --rays K --count N --compare-embree: the same
+// rays through kmbvh's traversal over B's tree and through Embree's own scene, every
+// difference counted, and the speed of both (issue #4; DESIGN.md §6).
+#include <fmt/format.h>
+
+#include <chrono>
+#include <nlohmann/json.hpp>
+#include <optional>
+#include <sstream>
+
+#include "adapters/embree/embree_scene.h"
+#include "adapters/out/tracer.h"
+#include "adapters/rays/hit_compare.h"
+#include "adapters/rays/ray_sets.h"
+#include "commands.h"
+#include "cuda/core/threads.h"
+#include "cuda/metrics/sah.h"
+#include "measure.h"
+#include "progress.h"
+#include "run_options.h"
+
+namespace kmbvh {
+namespace {
+
+using Json = nlohmann::ordered_json;
+
+std::vector<std::string> split(const std::string& list) {
+  std::vector<std::string> out;
+  std::stringstream in(list);
+  for (std::string item; std::getline(in, item, ',');)
+    if (!item.empty()) out.push_back(item);
+  return out;
+}
+
+std::vector<Layout> parse_layouts(const std::string& list) {
+  if (list == "all") return {Layout::Bvh2, Layout::Bvh4, Layout::Bvh8};
+  std::vector<Layout> out;
+  for (const std::string& name : split(list)) out.push_back(parse_layout(name));
+  if (out.empty()) throw std::invalid_argument("--layout: no layout given");
+  return out;
+}
+
+std::vector<RayKind> parse_kinds(const std::string& list) {
+  if (list == "all") return {RayKind::Primary, RayKind::Shadow, RayKind::Diffuse};
+  std::vector<RayKind> out;
+  for (const std::string& name : split(list)) out.push_back(parse_ray_kind(name));
+  if (out.empty()) throw std::invalid_argument("--rays: no ray kind given");
+  return out;
+}
+
+// Median wall time of `runs` calls after `warmup` untimed ones, in seconds.
+template <typename F>
+double median_seconds(int runs, int warmup, const F& f) {
+  for (int i = 0; i < warmup; ++i) f();
+  std::vector<double> ms;
+  for (int i = 0; i < runs; ++i) {
+    const auto start = std::chrono::steady_clock::now();
+    f();
+    ms.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+  return median(ms);
+}
+
+double mrays(size_t rays, double seconds) { return seconds > 0 ? double(rays) / seconds * 1e-6 : 0.0; }
+
+struct EmbreeResult {
+  std::vector<Hit> hits;  // rtcIntersect1 / rtcOccluded1
+  double single_mrays = 0, packet_mrays = 0;
+};
+
+struct KindResult {
+  RayKind kind = RayKind::Primary;
+  size_t rays = 0;
+  double mrays = 0;
+  const EmbreeResult* embree = nullptr;
+  HitComparison comparison;
+};
+
+Json ray_json(const Ray& r) {
+  return Json{{"org", {r.org.x, r.org.y, r.org.z}}, {"dir", {r.dir.x, r.dir.y, r.dir.z}}, {"tnear", r.tnear}, {"tfar", r.tfar}};
+}
+
+Json hit_json(const Hit& h) {
+  if (!h.found()) return Json{{"hit", false}};
+  return Json{{"hit", true}, {"t", h.t}, {"u", h.u}, {"v", h.v}, {"Ng", {h.Ng.x, h.Ng.y, h.Ng.z}}, {"geomID", h.geomID},
+              {"primID", h.primID}};
+}
+
+Json comparison_json(const HitComparison& c) {
+  Json first = Json::array();
+  for (const RayMismatch& m : c.first)
+    first.push_back(Json{{"index", m.index}, {"kind", m.kind}, {"ray", ray_json(m.ray)}, {"kmbvh", hit_json(m.ours)},
+                         {"embree", hit_json(m.reference)}});
+  return Json{{"mismatches", c.mismatches()}, {"hit_miss", c.hit_miss},   {"distance", c.distance},
+              {"primitive", c.primitive},     {"normal", c.normal},       {"barycentrics", c.barycentrics},
+              {"edge_ties", c.edge_ties},     {"embree_imprecise", c.embree_imprecise}, {"embree_hits", c.hits},    {"not_sent_to_embree", c.skipped},
+              {"first", first}};
+}
+
+std::string hit_text(const Hit& h) {
+  if (!h.found()) return "miss";
+  return fmt::format("t={:.9g} u={:.6g} v={:.6g} Ng=({:.6g}, {:.6g}, {:.6g}) prim={}", h.t, h.u, h.v, h.Ng.x, h.Ng.y, h.Ng.z,
+                     h.primID);
+}
+
+}  // namespace
+
+void add_trace_command(CLI::App& app, TraceCommand& c) {
+  CLI::App* cmd = app.add_subcommand("trace", "Trace rays through kmbvh's traversal of a builder's tree, against Embree's");
+  cmd->add_option("scene", c.scene, "glTF/OBJ file or a scene name in $KMBVH_SCENES (default: the embedded scene)");
+  add_builder_options(*cmd, c.builder);
+  cmd->add_option("--layout", c.layouts, "bvh2 (the portable kernel), bvh4, bvh8 (CPU SIMD), a list, or all");
+  cmd->add_option("--rays", c.rays, "primary, shadow, diffuse, a list, or all");
+  cmd->add_option("--count", c.count, "rays of each kind")->check(CLI::PositiveNumber);
+  cmd->add_option("--ray-seed", c.ray_seed, "seed of the rays' random draws");
+  cmd->add_flag("--compare-embree", c.compare_embree, "trace the same rays with Embree and count every difference");
+  cmd->add_option("--show", c.show, "mismatching rays printed in full");
+  add_run_options(*cmd, c.run);
+}
+
+int run_trace(const TraceCommand& c) {
+  apply_run_options(c.run);
+  const BuilderConfig config = builder_config(c.builder, c.run);
+  const std::vector<Layout> layouts = parse_layouts(c.layouts);
+  const std::vector<RayKind> kinds = parse_kinds(c.rays);
+  Progress progress(c.run.quiet);
+  progress.update(fmt::format("loading {}", c.scene.empty() ? "the default scene" : c.scene));
+  const LoadedScene scene = load_scene_argument(c.scene);
+
+  progress.update(fmt::format("building with {}", config.label()));
+  prepare_builder(config);
+  const Bvh bvh = run_builder(config, scene.prims);
+
+  // The rays do not depend on the builder under test: primary hits come from an LBVH of
+  // the scene, so every builder and layout is traced on the very same rays.
+  progress.update("making rays");
+  const Bvh helper_tree = run_builder(parse_builder("lbvh"), scene.prims);
+  const Tracer helper(helper_tree, scene.prims, scene.geometry, Layout::Bvh2);
+  const RaySets rays = make_ray_sets(scene.geometry, c.count, c.ray_seed,
+                                     [&](const std::vector<Ray>& r, std::vector<Hit>& h) { helper.trace(r, Query::Closest, h); });
+
+  std::optional<EmbreeScene> embree;
+  std::vector<EmbreeResult> embree_results(3);
+  if (c.compare_embree) {
+    progress.update("committing Embree's scene");
+    embree.emplace(scene.geometry);
+    for (const RayKind kind : kinds) {
+      progress.update(fmt::format("Embree: {} rays", to_string(kind)));
+      EmbreeResult& e = embree_results[int(kind)];
+      const std::vector<Ray>& set = rays.of(kind);
+      std::vector<Hit> packet_hits;
+      e.single_mrays = mrays(set.size(), median_seconds(c.run.runs, c.run.warmup, [&] {
+                               embree->trace(set, query_for(kind), EmbreeRays::Single, e.hits);
+                             }));
+      e.packet_mrays = mrays(set.size(), median_seconds(c.run.runs, c.run.warmup, [&] {
+                               embree->trace(set, query_for(kind), EmbreeRays::Packet16, packet_hits);
+                             }));
+    }
+  }
+
+  Json out{{"scene", scene.name},
+           {"triangles", scene.triangles},
+           {"builder", config.label()},
+           {"threads", thread_count()},
+           {"backend", to_string(config.backend)},
+           {"sah_cost", sah_cost(bvh)},
+           {"rays_per_kind", c.count},
+           {"ray_seed", c.ray_seed},
+           {"compare_embree", c.compare_embree}};
+  if (embree) out["embree_commit_ms"] = embree->commit_ms();
+  Json layout_rows = Json::array();
+  size_t mismatches = 0;
+  if (!c.run.json)
+    fmt::print("{} ({} triangles) · {} · SAH {:.1f} · {} threads · {} rays of each kind\n", scene.name, scene.triangles,
+               config.label(), sah_cost(bvh), thread_count(), c.count);
+  for (const Layout layout : layouts) {
+    progress.update(fmt::format("laying out {}", to_string(layout)));
+    const Tracer tracer(bvh, scene.prims, scene.geometry, layout, layout == Layout::Bvh2 ? config.backend : Backend::Cpu);
+    std::vector<KindResult> results;
+    for (const RayKind kind : kinds) {
+      progress.update(fmt::format("kmbvh {}: {} rays", to_string(layout), to_string(kind)));
+      KindResult r;
+      r.kind = kind;
+      r.rays = rays.of(kind).size();
+      std::vector<Hit> hits;
+      r.mrays = mrays(r.rays, median_seconds(c.run.runs, c.run.warmup, [&] { tracer.trace(rays.of(kind), query_for(kind), hits); }));
+      if (embree) {
+        r.embree = &embree_results[int(kind)];
+        r.comparison = compare_hits(scene.geometry, rays.of(kind), query_for(kind), hits, r.embree->hits, c.show);
+        mismatches += r.comparison.mismatches();
+      }
+      results.push_back(std::move(r));
+    }
+    const double traced_sah = sah_cost(tracer.traced_tree());
+    if (c.run.json) {
+      Json kinds_json = Json::array();
+      for (const KindResult& r : results) {
+        Json k{{"kind", to_string(r.kind)}, {"rays", r.rays}, {"kmbvh_mrays_per_s", r.mrays}};
+        if (r.embree) {
+          k["embree_mrays_per_s"] = r.embree->single_mrays;
+          k["embree16_mrays_per_s"] = r.embree->packet_mrays;
+          k["ratio_to_embree"] = r.embree->single_mrays > 0 ? r.mrays / r.embree->single_mrays : 0.0;
+          k["comparison"] = comparison_json(r.comparison);
+        }
+        kinds_json.push_back(k);
+      }
+      layout_rows.push_back(Json{{"layout", to_string(layout)}, {"collapsed", tracer.collapsed()},
+                                 {"traced_sah_cost", traced_sah}, {"layout_ms", tracer.layout_ms()},
+                                 {"layout_bytes", tracer.layout_bytes()}, {"stack_size", tracer.stack_size()},
+                                 {"kinds", kinds_json}});
+      continue;
+    }
+    progress.done();
+    fmt::print("\n{} layout{} · SAH of the traced tree {:.1f} · {:.1f} MB · laid out in {:.1f} ms\n", to_string(layout),
+               tracer.collapsed() ? " (collapsed by SAH from the binary tree)" : "", traced_sah,
+               double(tracer.layout_bytes()) / (1 << 20), tracer.layout_ms());
+    fmt::print("{:<8} {:>8} {:>13} {:>13} {:>7} {:>13} {:>10} {:>9}\n", "rays", "count", "kmbvh Mrays/s", "rtc*1 Mrays/s",
+               "ratio", "rtc*16 Mrays/s", "mismatch", "edge ties");
+    for (const KindResult& r : results) {
+      if (!r.embree) {
+        fmt::print("{:<8} {:>8} {:>13.2f}\n", to_string(r.kind), r.rays, r.mrays);
+        continue;
+      }
+      fmt::print("{:<8} {:>8} {:>13.2f} {:>13.2f} {:>7.2f} {:>13.2f} {:>10} {:>9}\n", to_string(r.kind), r.rays, r.mrays,
+                 r.embree->single_mrays, r.embree->single_mrays > 0 ? r.mrays / r.embree->single_mrays : 0.0,
+                 r.embree->packet_mrays, r.comparison.mismatches(), r.comparison.edge_ties);
+      const HitComparison& m = r.comparison;
+      if (m.mismatches())
+        fmt::print("  {} {} mismatches: hit/miss {}, distance {}, primitive {}, normal {}, barycentrics {}\n",
+                   m.mismatches(), to_string(r.kind), m.hit_miss, m.distance, m.primitive, m.normal, m.barycentrics);
+      for (const RayMismatch& x : m.first)
+        fmt::print("  ray {} ({}): org ({:.9g}, {:.9g}, {:.9g}) dir ({:.9g}, {:.9g}, {:.9g}) [{:.9g}, {:.9g}]\n"
+                   "    kmbvh:  {}\n    embree: {}\n",
+                   x.index, x.kind, x.ray.org.x, x.ray.org.y, x.ray.org.z, x.ray.dir.x, x.ray.dir.y, x.ray.dir.z, x.ray.tnear,
+                   x.ray.tfar, hit_text(x.ours), hit_text(x.reference));
+    }
+  }
+  progress.done();
+  if (c.run.json) {
+    out["layouts"] = layout_rows;
+    out["mismatches"] = mismatches;
+    fmt::print("{}\n", out.dump(2));
+  }
+  return mismatches ? kExitMismatch : kExitOk;
+}
+
+}  // namespace kmbvh

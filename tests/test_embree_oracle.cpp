@@ -1,0 +1,107 @@
+// The A/B oracle on real scenes (issue #4): for every file in the shared scene folder,
+// primary, shadow and diffuse rays ($KMBVH_TEST_RAYS of each kind, default 100,000)
+// through kmbvh's traversal of every builder's tree in every layout give Embree's hits:
+// zero mismatches beyond the documented edge ties (adapters/rays/hit_compare.h).
+#include <gtest/gtest.h>
+
+#include <cstdlib>
+#include <filesystem>
+
+#include "adapters/builder_registry.h"
+#include "adapters/embree/embree_scene.h"
+#include "adapters/in/load_scene.h"
+#include "adapters/in/scene_folder.h"
+#include "adapters/out/collapse_wide.h"
+#include "adapters/out/tracer.h"
+#include "adapters/rays/hit_compare.h"
+#include "adapters/rays/ray_sets.h"
+
+namespace kmbvh {
+namespace {
+
+size_t rays_per_kind() {
+  const char* env = std::getenv("KMBVH_TEST_RAYS");
+  return env ? std::strtoul(env, nullptr, 10) : 100000;
+}
+
+std::vector<std::string> scene_files() {
+  std::vector<std::string> files;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(scene_folder(), ec)) {
+    const std::string ext = entry.path().extension().string();
+    if (ext == ".glb" || ext == ".gltf" || ext == ".obj") files.push_back(entry.path().string());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
+
+// One scene's rays and Embree's answers to them, made once per scene.
+struct Oracle {
+  TriangleScene scene;
+  PrimitiveSet prims;
+  RaySets rays;
+  std::vector<Hit> embree[3];  // by RayKind
+};
+
+Oracle make_oracle(const std::string& file) {
+  Oracle o;
+  o.scene = load_scene_file(file);
+  o.prims = make_primitive_set(o.scene);
+  const Tracer helper(run_builder(parse_builder("lbvh"), o.prims), o.prims, o.scene, Layout::Bvh2);
+  o.rays = make_ray_sets(o.scene, rays_per_kind(), 7,
+                         [&](const std::vector<Ray>& r, std::vector<Hit>& h) { helper.trace(r, Query::Closest, h); });
+  const EmbreeScene embree(o.scene);
+  for (const RayKind kind : {RayKind::Primary, RayKind::Shadow, RayKind::Diffuse})
+    embree.trace(o.rays.of(kind), query_for(kind), EmbreeRays::Single, o.embree[int(kind)]);
+  return o;
+}
+
+BuilderConfig config_of(const std::string& spec) {
+  BuilderConfig c = parse_builder(spec.substr(0, spec.find('+')));
+  if (spec.find("+wide") != std::string::npos) {
+    c.kmeans.wide = true;
+    c.kmeans.k = spec.back() == '4' ? 4 : 8;
+  }
+  return c;
+}
+
+class EmbreeOracle : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(EmbreeOracle, SameHitsAsEmbreeOnEveryScene) {
+  const auto files = scene_files();
+  if (files.empty()) GTEST_SKIP() << "no scenes in " << scene_folder() << " (set KMBVH_SCENES to the shared scene folder)";
+  const BuilderConfig config = config_of(GetParam());
+  for (const std::string& file : files) {
+    const Oracle o = make_oracle(file);
+    ASSERT_GT(o.rays.primary.size(), 0u) << file;
+    const Bvh bvh = run_builder(config, o.prims);
+    for (const Layout layout : {Layout::Bvh2, Layout::Bvh4, Layout::Bvh8}) {
+      if (tree_arity(bvh) > layout_width(layout)) continue;
+      const Tracer tracer(bvh, o.prims, o.scene, layout);
+      for (const RayKind kind : {RayKind::Primary, RayKind::Shadow, RayKind::Diffuse}) {
+        const std::vector<Ray>& rays = o.rays.of(kind);
+        std::vector<Hit> hits;
+        tracer.trace(rays, query_for(kind), hits);
+        const HitComparison c = compare_hits(o.scene, rays, query_for(kind), hits, o.embree[int(kind)], 1);
+        EXPECT_EQ(c.mismatches(), 0u) << std::filesystem::path(file).filename().string() << ", " << config.label() << ", "
+                                      << to_string(layout) << ", " << to_string(kind) << " rays: hit/miss " << c.hit_miss
+                                      << ", distance " << c.distance << ", primitive " << c.primitive << ", normal "
+                                      << c.normal << ", barycentrics " << c.barycentrics;
+        EXPECT_GE(rays.size(), rays_per_kind()) << file;
+      }
+    }
+  }
+}
+
+INSTANTIATE_TEST_SUITE_P(Builders, EmbreeOracle,
+                         ::testing::Values("sweep-sah", "lbvh", "hlbvh", "atrbvh", "ploc", "Q1", "Q2", "Q3", "Q4", "Q5",
+                                           "Q2+wide4", "Q2+wide8", "embree-low", "embree-medium", "embree-high"),
+                         [](const auto& info) {
+                           std::string name = info.param;
+                           for (char& c : name)
+                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+                           return name;
+                         });
+
+}  // namespace
+}  // namespace kmbvh

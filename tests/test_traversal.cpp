@@ -1,0 +1,274 @@
+// kmbvh's traversal (issue #4): every layout over every builder's tree gives the hits a
+// brute-force loop over all triangles gives; any-hit agrees with closest-hit; degenerate
+// rays and triangles; trees deeper than any fixed stack.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <limits>
+
+#include "adapters/builder_registry.h"
+#include "adapters/out/collapse_wide.h"
+#include "adapters/out/tracer.h"
+#include "adapters/rays/hit_compare.h"
+#include "cuda/metrics/validate.h"
+#include "cuda/traversal/watertight.h"
+#include "support/rays.h"
+#include "support/scenes.h"
+
+namespace kmbvh {
+namespace {
+
+constexpr float kInf = std::numeric_limits<float>::infinity();
+
+// Every triangle, with the same watertight test the traversals use: a correct traversal
+// gives exactly these hits (up to which of several triangles at one t it reports).
+std::vector<Hit> brute_force(const TriangleScene& scene, const std::vector<Ray>& rays, Query query) {
+  std::vector<Hit> hits(rays.size());
+  for (size_t r = 0; r < rays.size(); ++r) {
+    const Ray& ray = rays[r];
+    if (!ray_is_valid(ray) || !(ray.tnear <= ray.tfar)) continue;
+    const RayShear shear(ray);
+    float tmax = ray.tfar;
+    uint32_t best = kInvalidId;
+    Hit h;
+    for (uint32_t t = 0; t < scene.size() && !(query == Query::Any && best != kInvalidId); ++t) {
+      const Triangle& v = scene.triangles[t];
+      if (is_degenerate_triangle(scene.positions[v[0]], scene.positions[v[1]], scene.positions[v[2]])) continue;
+      if (intersect_watertight(shear, ray.tnear, tmax, scene.positions[v[0]], scene.positions[v[1]], scene.positions[v[2]], h))
+        best = t, tmax = h.t;
+    }
+    if (best == kInvalidId) continue;
+    const Triangle& v = scene.triangles[best];
+    refine_hit(ray, scene.positions[v[0]], scene.positions[v[1]], scene.positions[v[2]], h);
+    h.geomID = 0;
+    h.primID = best;
+    hits[r] = h;
+  }
+  return hits;
+}
+
+std::vector<Ray> test_rays(const TriangleScene& scene, uint32_t n, uint32_t seed) {
+  std::vector<Ray> rays;
+  for (uint32_t i = 0; i < n; ++i) {
+    const test::Ray r = i % 2 ? test::random_ray(scene.bounds(), seed, i) : test::ray_towards_triangle(scene, seed + 1, i);
+    Ray ray;
+    ray.org = r.origin;
+    ray.dir = r.direction;
+    ray.tfar = i % 7 == 3 ? 0.5f : kInf;  // some bounded intervals too
+    rays.push_back(ray);
+  }
+  return rays;
+}
+
+struct Case {
+  std::string spec;  // builder, as parse_builder reads it, "+wide4"/"+wide8" for k-means' k-ary tree
+  BuilderConfig config() const {
+    BuilderConfig c = parse_builder(spec.substr(0, spec.find('+')));
+    if (spec.find("+wide") != std::string::npos) {
+      c.kmeans.wide = true;
+      c.kmeans.k = spec.back() == '4' ? 4 : 8;
+    }
+    return c;
+  }
+};
+
+std::vector<Layout> layouts_for(const Bvh& bvh) {
+  const uint32_t arity = tree_arity(bvh);
+  std::vector<Layout> out;
+  for (Layout l : {Layout::Bvh2, Layout::Bvh4, Layout::Bvh8})
+    if (layout_width(l) >= arity) out.push_back(l);
+  return out;
+}
+
+void expect_layouts_match_brute_force(const TriangleScene& scene, const std::vector<Ray>& rays, const std::string& what) {
+  const PrimitiveSet prims = make_primitive_set(scene);
+  const std::vector<Hit> closest = brute_force(scene, rays, Query::Closest);
+  for (const char* spec : {"sweep-sah", "lbvh", "hlbvh", "atrbvh", "ploc", "Q1", "Q3", "Q5", "embree-low", "embree-medium",
+                           "Q2+wide4", "Q2+wide8"}) {
+    const BuilderConfig config = Case{spec}.config();
+    const Bvh bvh = run_builder(config, prims);
+    for (const Layout layout : layouts_for(bvh)) {
+      const Tracer tracer(bvh, prims, scene, layout);
+      EXPECT_TRUE(validate(tracer.traced_tree(), prims, ValidationLimits{config.max_leaf_size, 64}).ok());
+      std::vector<Hit> hits, any;
+      tracer.trace(rays, Query::Closest, hits);
+      const HitComparison c = compare_hits(scene, rays, Query::Closest, hits, closest);
+      EXPECT_EQ(c.mismatches(), 0u) << what << ", " << spec << ", " << to_string(layout);
+      for (size_t r = 0; r < rays.size(); ++r) {
+        if (hits[r].found() && hits[r].primID == closest[r].primID) {
+          ASSERT_EQ(hits[r].t, closest[r].t) << spec << " ray " << r;
+        }
+      }
+      // Occlusion agrees with closest hit: occluded iff a hit exists in the interval.
+      tracer.trace(rays, Query::Any, any);
+      for (size_t r = 0; r < rays.size(); ++r)
+        ASSERT_EQ(any[r].found(), hits[r].found()) << what << ", " << spec << ", " << to_string(layout) << ", ray " << r;
+    }
+  }
+}
+
+TEST(Traversal, RandomSceneEveryBuilderEveryLayout) {
+  const TriangleScene scene = test::random_triangles(3000, 31);
+  expect_layouts_match_brute_force(scene, test_rays(scene, 2000, 5), "random");
+}
+
+TEST(Traversal, ClusteredSceneEveryBuilderEveryLayout) {
+  const TriangleScene scene = test::clustered_triangles(3000, 32);
+  expect_layouts_match_brute_force(scene, test_rays(scene, 2000, 6), "clustered");
+}
+
+TEST(Traversal, IdenticalTrianglesEveryBuilderEveryLayout) {
+  const TriangleScene scene = test::identical_triangles(500);
+  expect_layouts_match_brute_force(scene, test_rays(scene, 500, 7), "identical");
+}
+
+// A tree whose depth is the number of triangles: node i has leaf i and node i + 1 below it.
+Bvh chain_tree(const PrimitiveSet& prims) {
+  const uint32_t n = uint32_t(prims.size());
+  Bvh bvh;
+  bvh.prim_indices.resize(n);
+  for (uint32_t i = 0; i < n; ++i) bvh.prim_indices[i] = i;
+  // Node layout: interior i at 2i, its children at 2i+1 (leaf i) and 2i+2 (interior i+1,
+  // or the last leaf).
+  bvh.nodes.resize(2 * n - 1);
+  Aabb below = prims.boxes[n - 1];
+  bvh.nodes[2 * n - 2] = BvhNode::make_leaf(below, n - 1, 1);
+  for (int i = int(n) - 2; i >= 0; --i) {
+    bvh.nodes[2 * i + 1] = BvhNode::make_leaf(prims.boxes[i], uint32_t(i), 1);
+    below = join(below, prims.boxes[i]);
+    bvh.nodes[2 * i] = BvhNode::make_interior(below, 2 * i + 1, 2);
+  }
+  return bvh;
+}
+
+TEST(Traversal, ChainDeeperThanAnyFixedStack) {
+  const TriangleScene scene = test::random_triangles(4000, 33);
+  const PrimitiveSet prims = make_primitive_set(scene);
+  const Bvh chain = chain_tree(prims);
+  ASSERT_TRUE(validate(chain, prims, ValidationLimits{1, 2}).ok());
+  const std::vector<Ray> rays = test_rays(scene, 400, 8);
+  const std::vector<Hit> expected = brute_force(scene, rays, Query::Closest);
+  for (const Layout layout : {Layout::Bvh2, Layout::Bvh4, Layout::Bvh8}) {
+    const Tracer tracer(chain, prims, scene, layout);
+    EXPECT_GE(tracer.stack_size(), 4000u / (layout_width(layout) - 1));
+    std::vector<Hit> hits;
+    tracer.trace(rays, Query::Closest, hits);
+    EXPECT_EQ(compare_hits(scene, rays, Query::Closest, hits, expected).mismatches(), 0u) << to_string(layout);
+  }
+}
+
+TEST(Traversal, ZeroAreaTrianglesAreNeverHit) {
+  const TriangleScene scene = test::zero_area_triangles(2000, 23);
+  const PrimitiveSet prims = make_primitive_set(scene);
+  const Bvh bvh = run_builder(parse_builder("Q2"), prims);
+  const std::vector<Ray> rays = test_rays(scene, 2000, 9);
+  for (const Layout layout : {Layout::Bvh2, Layout::Bvh4, Layout::Bvh8}) {
+    std::vector<Hit> hits;
+    Tracer(bvh, prims, scene, layout).trace(rays, Query::Closest, hits);
+    for (const Hit& h : hits) ASSERT_FALSE(h.found()) << to_string(layout);
+  }
+}
+
+// A unit square in the z = 0 plane, two triangles sharing the diagonal.
+TriangleScene unit_square() {
+  TriangleScene s;
+  s.add_triangle(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0));
+  s.add_triangle(Vec3(0, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0));
+  return s;
+}
+
+Ray make_ray(Vec3 org, Vec3 dir, float tnear = 0.0f, float tfar = kInf) {
+  Ray r;
+  r.org = org;
+  r.dir = dir;
+  r.tnear = tnear;
+  r.tfar = tfar;
+  return r;
+}
+
+TEST(Traversal, EmbreeConventionsOnASquare) {
+  const TriangleScene scene = unit_square();
+  const PrimitiveSet prims = make_primitive_set(scene);
+  const Bvh bvh = run_builder(parse_builder("lbvh"), prims);
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  struct Expect {
+    Ray ray;
+    bool hit;
+    const char* what;
+  };
+  const std::vector<Expect> cases = {
+      {make_ray(Vec3(0.7f, 0.2f, -1), Vec3(0, 0, 1)), true, "straight through"},
+      {make_ray(Vec3(0.5f, 0.5f, -1), Vec3(0, 0, 1)), true, "through the shared diagonal: never between the triangles"},
+      {make_ray(Vec3(0.7f, 0.2f, -1), Vec3(0, 0, 1), 0.0f, 1.0f), true, "t == tfar is a hit"},
+      {make_ray(Vec3(0.7f, 0.2f, -1), Vec3(0, 0, 1), 1.0f), false, "t == tnear is not"},
+      {make_ray(Vec3(0.7f, 0.2f, -1), Vec3(0, 0, 1), 5.0f, 1.0f), false, "tnear > tfar"},
+      {make_ray(Vec3(0.7f, 0.2f, 0), Vec3(0, 0, 1)), false, "starting on the surface"},
+      {make_ray(Vec3(-1, 0.2f, 0), Vec3(1, 0, 0)), false, "parallel, in the plane"},
+      {make_ray(Vec3(-1, 0.2f, 0.5f), Vec3(1, 0, 0)), false, "parallel, above"},
+      {make_ray(Vec3(0.7f, 0.2f, -1), Vec3(0, 0, 0)), false, "zero direction"},
+      {make_ray(Vec3(0.7f, 0.2f, -1), Vec3(nan, 0, 1)), false, "NaN direction"},
+      {make_ray(Vec3(kInf, 0.2f, -1), Vec3(0, 0, 1)), false, "infinite origin"},
+      {make_ray(Vec3(0.7f, 0.2f, -1), Vec3(0, 0, 1), -1.0f), false, "negative tnear"},
+      {make_ray(Vec3(0.7f, 0.2f, -1), Vec3(0, 0, 1), nan), false, "NaN tnear"},
+      {make_ray(Vec3(0.7f, 0.2f, -1), Vec3(0, 0, 1), 0.0f, nan), false, "NaN tfar"},
+  };
+  std::vector<Ray> rays;
+  for (const Expect& e : cases) rays.push_back(e.ray);
+  for (const Layout layout : {Layout::Bvh2, Layout::Bvh4, Layout::Bvh8}) {
+    const Tracer tracer(bvh, prims, scene, layout);
+    for (const Query query : {Query::Closest, Query::Any}) {
+      std::vector<Hit> hits;
+      tracer.trace(rays, query, hits);
+      for (size_t i = 0; i < cases.size(); ++i) EXPECT_EQ(hits[i].found(), cases[i].hit) << cases[i].what << ", " << to_string(layout);
+    }
+    std::vector<Hit> hits;
+    tracer.trace(rays, Query::Closest, hits);
+    // Embree's conventions: t, u weighs the second vertex, v the third, Ng = (v1 - v0) x (v2 - v0).
+    EXPECT_FLOAT_EQ(hits[0].t, 1.0f);
+    EXPECT_EQ(hits[0].primID, 0u);
+    EXPECT_NEAR(hits[0].u, 0.5f, 1e-6f);
+    EXPECT_NEAR(hits[0].v, 0.2f, 1e-6f);
+    EXPECT_EQ(hits[0].Ng.z, 1.0f);
+  }
+}
+
+TEST(Traversal, EmptyAndTinyScenes) {
+  for (const uint32_t n : {0u, 1u, 2u}) {
+    TriangleScene scene;
+    for (uint32_t i = 0; i < n; ++i) scene.add_triangle(Vec3(float(i), 0, 0), Vec3(float(i) + 1, 0, 0), Vec3(float(i), 1, 0));
+    const PrimitiveSet prims = make_primitive_set(scene);
+    const Bvh bvh = run_builder(parse_builder("Q2"), prims);
+    const std::vector<Ray> rays = {make_ray(Vec3(0.2f, 0.2f, -1), Vec3(0, 0, 1))};
+    for (const Layout layout : {Layout::Bvh2, Layout::Bvh4, Layout::Bvh8}) {
+      std::vector<Hit> hits;
+      Tracer(bvh, prims, scene, layout).trace(rays, Query::Closest, hits);
+      EXPECT_EQ(hits[0].found(), n > 0) << n << " triangles, " << to_string(layout);
+    }
+  }
+}
+
+TEST(Traversal, CollapseKeepsPrimitivesAndFillsNodes) {
+  const TriangleScene scene = test::random_triangles(5000, 34);
+  const PrimitiveSet prims = make_primitive_set(scene);
+  const Bvh bvh = run_builder(parse_builder("sweep-sah"), prims);
+  for (const uint32_t width : {4u, 8u}) {
+    const Bvh wide = collapse_to_width(bvh, width);
+    EXPECT_TRUE(validate(wide, prims, ValidationLimits{8, width}).ok());
+    EXPECT_EQ(tree_arity(wide), width);
+    EXPECT_LT(wide.nodes.size(), bvh.nodes.size());
+  }
+  BuilderConfig kary = parse_builder("Q3");
+  kary.kmeans.wide = true;
+  EXPECT_THROW(collapse_to_width(run_builder(kary, prims), 8), std::invalid_argument);  // k = 16 does not fit 8 lanes
+}
+
+TEST(Traversal, Bvh2NeedsABinaryTree) {
+  const TriangleScene scene = test::random_triangles(1000, 35);
+  const PrimitiveSet prims = make_primitive_set(scene);
+  BuilderConfig kary = parse_builder("Q2");
+  kary.kmeans.wide = true;
+  EXPECT_THROW(Tracer(run_builder(kary, prims), prims, scene, Layout::Bvh2), std::invalid_argument);
+}
+
+}  // namespace
+}  // namespace kmbvh
