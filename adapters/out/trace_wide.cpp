@@ -4,6 +4,7 @@
 #include <omp.h>
 
 #include <cstring>
+#include <type_traits>
 
 #include "cuda/traversal/ray_box.h"
 #include "cuda/traversal/watertight.h"
@@ -13,6 +14,21 @@ namespace {
 
 typedef float vf4 __attribute__((vector_size(16)));
 typedef float vf8 __attribute__((vector_size(32)));
+typedef int vi4 __attribute__((vector_size(16)));
+typedef int vi8 __attribute__((vector_size(32)));
+// The pack's vector types: as many lanes as a TrianglePack has slots.
+using vfp = std::conditional_t<kPackWidth == 8, vf8, vf4>;
+using vip = std::conditional_t<kPackWidth == 8, vi8, vi4>;
+inline unsigned pack_mask(vi4 m) { return unsigned(_mm_movemask_ps(__m128(m))); }
+inline unsigned pack_mask(vi8 m) {
+#if defined(__AVX__)
+  return unsigned(_mm256_movemask_ps(__m256(m)));
+#else
+  unsigned bits = 0;
+  for (int i = 0; i < 8; ++i) bits |= unsigned(m[i] != 0) << i;
+  return bits;
+#endif
+}
 template <int W>
 struct Lanes;
 template <>
@@ -51,43 +67,116 @@ inline typename Lanes<W>::V load(const float* p) {
   return v;
 }
 
-// Per-ray constants of the slab test, broadcast to every lane.
+// Per-ray constants of the slab test, broadcast to every lane; the near and far planes of
+// each axis as offsets into a node's lo/hi arrays, chosen once by the direction's signs.
 template <int W>
 struct WideRay {
   using V = typename Lanes<W>::V;
   V org[3], inv[3];
-  int near[3];
+  int near_plane[3], far_plane[3];
   explicit WideRay(const RayBoxSetup& s) {
+    const int near_sign[3] = {s.near_x, s.near_y, s.near_z};
     for (int d = 0; d < 3; ++d) {
       org[d] = V{} + s.org[d];
       inv[d] = V{} + s.inv[d];
+      near_plane[d] = (near_sign[d] ? 3 * W : 0) + d * W;  // hi follows lo in WideNode
+      far_plane[d] = (near_sign[d] ? 0 : 3 * W) + d * W;
     }
-    near[0] = s.near_x;
-    near[1] = s.near_y;
-    near[2] = s.near_z;
   }
 };
 
 template <int W>
-inline unsigned enter_children(const WideNode<W>& n, const WideRay<W>& r, float tnear, float tmax, float* entry) {
+inline unsigned enter_children(const WideNode<W>& n, const WideRay<W>& r, float tnear, float tmax,
+                               typename Lanes<W>::V& entry) {
   using V = typename Lanes<W>::V;
+  const float* planes = &n.lo[0][0];
   V t0 = V{} + tnear, t1 = V{} + tmax;
   for (int d = 0; d < 3; ++d) {
-    const V near_plane = load<W>(r.near[d] ? n.hi[d] : n.lo[d]);
-    const V far_plane = load<W>(r.near[d] ? n.lo[d] : n.hi[d]);
-    t0 = vmax(t0, (near_plane - r.org[d]) * r.inv[d]);
-    t1 = vmin(t1, (far_plane - r.org[d]) * r.inv[d]);
+    t0 = vmax(t0, (load<W>(planes + r.near_plane[d]) - r.org[d]) * r.inv[d]);
+    t1 = vmin(t1, (load<W>(planes + r.far_plane[d]) - r.org[d]) * r.inv[d]);
   }
-  t1 = t1 * kRobustExit;
-  std::memcpy(entry, &t0, sizeof(t0));
-  return lane_mask(t0, t1);
+  entry = t0;
+  return lane_mask(t0, t1 * kRobustExit);
+}
+
+inline vfp load4(const float* p) {
+  vfp v;
+  std::memcpy(&v, p, sizeof(v));
+  return v;
+}
+
+// The watertight test's per-ray set-up, broadcast to the four slots of a pack.
+struct PackRay {
+  RayShear shear;
+  vfp org[3];  // the origin's kx, ky, kz components
+  vfp sx, sy, sz;
+  explicit PackRay(const Ray& ray) : shear(ray) {
+    org[0] = vfp{} + ray.org[shear.kx];
+    org[1] = vfp{} + ray.org[shear.ky];
+    org[2] = vfp{} + ray.org[shear.kz];
+    sx = vfp{} + shear.sx;
+    sy = vfp{} + shear.sy;
+    sz = vfp{} + shear.sz;
+  }
+};
+
+// The watertight test (cuda/traversal/watertight.h) on four triangles at once, in the
+// same operations as the scalar test. Returns the slot of the nearest hit in (tnear,
+// tmax] and its t, or -1. A slot whose edge functions come out exactly zero goes to the
+// scalar test, which redoes them in double precision.
+inline int intersect_pack(const TrianglePack& p, const PackRay& r, float tnear, float tmax, float& t_hit) {
+  const RayShear& s = r.shear;
+  vfp x[3], y[3], z[3];
+  for (int v = 0; v < 3; ++v) {
+    const vfp dx = load4(p.v[v][s.kx]) - r.org[0], dy = load4(p.v[v][s.ky]) - r.org[1];
+    z[v] = load4(p.v[v][s.kz]) - r.org[2];
+    x[v] = dx - r.sx * z[v];
+    y[v] = dy - r.sy * z[v];
+  }
+  const vfp U = x[2] * y[1] - y[2] * x[1];
+  const vfp V = x[0] * y[2] - y[0] * x[2];
+  const vfp W = x[1] * y[0] - y[1] * x[0];
+  const vfp zero{};
+  const vip negative = (U < zero) | (V < zero) | (W < zero);
+  const vip positive = (U > zero) | (V > zero) | (W > zero);
+  const vfp det = U + V + W;
+  const vfp T = U * (r.sz * z[0]) + V * (r.sz * z[1]) + W * (r.sz * z[2]);
+  const vip sign = vip(det) & (vip{} + int(0x80000000));
+  const vfp abs_det = vfp(vip(det) ^ sign), abs_T = vfp(vip(T) ^ sign);
+  const vip valid = ~(negative & positive) & (det != zero) & (abs_T > (vfp{} + tnear) * abs_det) &
+                    (abs_T <= (vfp{} + tmax) * abs_det);
+  const vip exact_zero = (U == zero) | (V == zero) | (W == zero);
+  unsigned hits = (pack_mask(valid & ~exact_zero));
+  unsigned redo = (pack_mask(exact_zero));
+  int best = -1;
+  if (hits) {
+    const vfp t = T / det;
+    for (; hits; hits &= hits - 1) {
+      const int slot = __builtin_ctz(hits);
+      if (best < 0 || t[slot] < t_hit) best = slot, t_hit = t[slot];
+    }
+  }
+  for (; redo; redo &= redo - 1) {
+    const int slot = __builtin_ctz(redo);
+    const Vec3 a(p.v[0][0][slot], p.v[0][1][slot], p.v[0][2][slot]);
+    const Vec3 b(p.v[1][0][slot], p.v[1][1][slot], p.v[1][2][slot]);
+    const Vec3 c(p.v[2][0][slot], p.v[2][1][slot], p.v[2][2][slot]);
+    Hit h;
+    if (intersect_watertight(s, tnear, best < 0 ? tmax : t_hit, a, b, c, h)) best = slot, t_hit = h.t;
+  }
+  return best;
 }
 
 template <int W>
 bool finish_hit(const WideBvh<W>& bvh, const Ray& ray, uint32_t found, Hit& hit) {
   if (found == kInvalidId) return false;
-  const LeafTriangle& tri = bvh.triangles[found];
-  refine_hit(ray, tri.a, tri.b, tri.c, hit);
+  const TrianglePack& p = bvh.packs[found / kPackWidth];
+  const uint32_t slot = found % kPackWidth;
+  const Vec3 a(p.v[0][0][slot], p.v[0][1][slot], p.v[0][2][slot]);
+  const Vec3 b(p.v[1][0][slot], p.v[1][1][slot], p.v[1][2][slot]);
+  const Vec3 c(p.v[2][0][slot], p.v[2][1][slot], p.v[2][2][slot]);
+  hit.Ng = cross(b - a, c - a);
+  refine_hit(ray, a, b, c, hit);
   hit.geomID = bvh.ids[found].geom;
   hit.primID = bvh.ids[found].prim;
   return true;
@@ -102,38 +191,56 @@ bool trace_wide_ray(const WideBvh<W>& bvh, const Ray& ray, Query query, WideEntr
   if (ray.dir.x == 0.0f && ray.dir.y == 0.0f && ray.dir.z == 0.0f) return false;
   const RayBoxSetup setup(ray);
   const WideRay<W> wray(setup);
-  const RayShear shear(ray);
+  const PackRay pack_ray(ray);
   float tmax = ray.tfar;
   uint32_t found = kInvalidId;  // the closest hit's triangle so far
   uint32_t sp = 0;
   WideEntry cur{0, 0, ray.tnear};
-  alignas(32) float entry[W];
   for (;;) {
     if (cur.count == 0) {
       const WideNode<W>& n = bvh.nodes[cur.ref];
+      typename Lanes<W>::V entry;
       unsigned mask = enter_children(n, wray, ray.tnear, tmax, entry);
       if (mask == 0) goto pop;
-      // The nearest entered child is taken next; the others go on the stack farthest first.
+      int lane = __builtin_ctz(mask);
+      mask &= mask - 1;
+      if (mask == 0) {  // one child entered: the common case, no ordering
+        cur = WideEntry{n.ref[lane], n.count[lane], entry[lane]};
+        continue;
+      }
+      if (query == Query::Any) {  // any hit will do: no ordering
+        stack[sp++] = WideEntry{n.ref[lane], n.count[lane], entry[lane]};
+        for (; mask; mask &= mask - 1) {
+          lane = __builtin_ctz(mask);
+          stack[sp++] = WideEntry{n.ref[lane], n.count[lane], entry[lane]};
+        }
+        cur = stack[--sp];
+        continue;
+      }
+      // Several: the nearest is taken next, the others go on the stack farthest first.
       WideEntry hits[W];
-      int count = 0;
-      while (mask) {
-        const int lane = __builtin_ctz(mask);
+      hits[0] = WideEntry{n.ref[lane], n.count[lane], entry[lane]};
+      int count = 1;
+      do {
+        lane = __builtin_ctz(mask);
         mask &= mask - 1;
-        WideEntry e{n.ref[lane], n.count[lane], entry[lane]};
+        const WideEntry e{n.ref[lane], n.count[lane], entry[lane]};
         int at = count++;
         for (; at > 0 && hits[at - 1].entry < e.entry; --at) hits[at] = hits[at - 1];
         hits[at] = e;
-      }
+      } while (mask);
       for (int i = 0; i < count - 1; ++i) stack[sp++] = hits[i];
       cur = hits[count - 1];
       continue;
     }
-    for (uint32_t i = cur.ref; i < cur.ref + cur.count; ++i) {
-      const LeafTriangle& tri = bvh.triangles[i];
-      if (!intersect_watertight(shear, ray.tnear, tmax, tri.a, tri.b, tri.c, hit)) continue;
-      found = i;
+    for (uint32_t p = cur.ref, end = cur.ref + (cur.count + kPackWidth - 1) / kPackWidth; p < end; ++p) {
+      float t;
+      const int slot = intersect_pack(bvh.packs[p], pack_ray, ray.tnear, tmax, t);
+      if (slot < 0) continue;
+      found = p * kPackWidth + uint32_t(slot);
+      hit.t = t;
       if (query == Query::Any) return finish_hit(bvh, ray, found, hit);
-      tmax = hit.t;
+      tmax = t;
     }
   pop:
     do {

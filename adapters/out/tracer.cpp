@@ -66,12 +66,17 @@ void Tracer::trace(const std::vector<Ray>& rays, Query query, std::vector<Hit>& 
   }
 }
 
+template <int W>
+size_t wide_bytes(const WideBvh<W>& b) {
+  return b.nodes.size() * sizeof(WideNode<W>) + b.packs.size() * sizeof(TrianglePack) + b.ids.size() * sizeof(PrimitiveId);
+}
+
 size_t Tracer::layout_bytes() const {
   const auto tri_bytes = [](size_t n) { return n * (sizeof(LeafTriangle) + sizeof(PrimitiveId)); };
   switch (layout_) {
     case Layout::Bvh2: return layouts_->bvh2.nodes.size() * sizeof(Bvh2Node) + tri_bytes(layouts_->bvh2.triangles.size());
-    case Layout::Bvh4: return layouts_->bvh4.nodes.size() * sizeof(WideNode<4>) + tri_bytes(layouts_->bvh4.triangles.size());
-    case Layout::Bvh8: return layouts_->bvh8.nodes.size() * sizeof(WideNode<8>) + tri_bytes(layouts_->bvh8.triangles.size());
+    case Layout::Bvh4: return wide_bytes(layouts_->bvh4);
+    case Layout::Bvh8: return wide_bytes(layouts_->bvh8);
   }
   return 0;
 }

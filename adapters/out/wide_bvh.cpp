@@ -1,7 +1,10 @@
 #include "wide_bvh.h"
 
+#include "cuda/traversal/ray.h"
+
 #include <algorithm>
 #include <cfloat>
+#include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
@@ -23,14 +26,36 @@ WideNode<W> empty_node() {
   return n;
 }
 
+// Packs the triangles of leaf n; returns its first pack.
 template <int W>
-void set_lane(WideNode<W>& out, int lane, const BvhNode& n, uint32_t ref) {
+uint32_t pack_leaf(WideBvh<W>& out, const BvhNode& n, const LeafTriangles& triangles) {
+  const uint32_t first = uint32_t(out.packs.size());
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (uint32_t i = 0; i < n.count; i += kPackWidth) {
+    TrianglePack pack;
+    for (int slot = 0; slot < kPackWidth; ++slot) {
+      const bool used = i + slot < n.count;
+      const LeafTriangle* t = used ? &triangles.triangles[n.first + i + slot] : nullptr;
+      for (int axis = 0; axis < 3; ++axis) {
+        pack.v[0][axis][slot] = used ? t->a[axis] : nan;
+        pack.v[1][axis][slot] = used ? t->b[axis] : nan;
+        pack.v[2][axis][slot] = used ? t->c[axis] : nan;
+      }
+      out.ids.push_back(used ? triangles.ids[n.first + i + slot] : PrimitiveId{kInvalidId, kInvalidId});
+    }
+    out.packs.push_back(pack);
+  }
+  return first;
+}
+
+template <int W>
+void set_lane(WideBvh<W>& bvh, WideNode<W>& out, int lane, const BvhNode& n, const LeafTriangles& triangles) {
   if (n.is_leaf() && n.count == 0) return;  // the empty set's leaf: leave the lane empty
   for (int d = 0; d < 3; ++d) {
     out.lo[d][lane] = n.box.lo[d];
     out.hi[d][lane] = n.box.hi[d];
   }
-  out.ref[lane] = n.is_leaf() ? n.first : ref;
+  out.ref[lane] = n.is_leaf() ? pack_leaf(bvh, n, triangles) : 0;  // an interior child's index is set when it is written
   out.count[lane] = n.is_leaf() ? n.count : 0;
 }
 
@@ -39,12 +64,12 @@ void set_lane(WideNode<W>& out, int lane, const BvhNode& n, uint32_t ref) {
 template <int W>
 WideBvh<W> make_wide_bvh(const Bvh& bvh, LeafTriangles triangles) {
   WideBvh<W> out;
-  out.triangles = std::move(triangles.triangles);
-  out.ids = std::move(triangles.ids);
+  out.packs.reserve(bvh.prim_indices.size() / 2);
+  out.ids.reserve(bvh.prim_indices.size() * 2);
   if (bvh.empty() || (bvh.root().is_leaf() && bvh.root().count == 0)) return out;
   if (bvh.root().is_leaf()) {  // one leaf: a root with a single lane
     out.nodes.push_back(empty_node<W>());
-    set_lane(out.nodes[0], 0, bvh.root(), 0);
+    set_lane(out, out.nodes[0], 0, bvh.root(), triangles);
     return out;
   }
   struct Pending {
@@ -65,7 +90,7 @@ WideBvh<W> make_wide_bvh(const Bvh& bvh, LeafTriangles triangles) {
     max_depth = std::max(max_depth, p.depth);
     for (int c = int(n.count) - 1; c >= 0; --c) {
       const BvhNode& child = bvh.nodes[n.first + c];
-      set_lane(out.nodes[index], c, child, 0);
+      set_lane(out, out.nodes[index], c, child, triangles);
       if (!child.is_leaf()) stack.push_back({n.first + uint32_t(c), index, uint32_t(c), p.depth + 1});
     }
   }

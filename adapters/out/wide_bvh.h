@@ -1,7 +1,9 @@
 // 4- and 8-wide node layouts for SIMD traversal on the CPU: one node holds the boxes of
 // all its children as structure-of-arrays (lo and hi per axis, W lanes each), so one ray
 // tests every child box with a handful of vector instructions. Unused lanes hold an empty
-// box (lo = +max, hi = -max), which the slab test never enters.
+// box (lo = +max, hi = -max), which the slab test never enters. A leaf's triangles are
+// packed four at a time as structure-of-arrays (as Embree's Triangle4), so one ray tests
+// four triangles with the same vector instructions; unused slots hold never-hit triangles.
 #pragma once
 
 #include <cstdint>
@@ -16,15 +18,22 @@ template <int W>
 struct alignas(64) WideNode {
   float lo[3][W];
   float hi[3][W];
-  uint32_t ref[W];    // interior child: its node index; leaf child: its first triangle
+  uint32_t ref[W];    // interior child: its node index; leaf child: its first triangle pack
   uint32_t count[W];  // 0 for an interior child; the leaf's triangle count otherwise
+};
+
+constexpr int kPackWidth = 8;
+
+// Four triangles: v[vertex][axis][slot]. Slot s of pack p is triangle kPackWidth * p + s.
+struct alignas(32) TrianglePack {
+  float v[3][3][kPackWidth];
 };
 
 template <int W>
 struct WideBvh {
   std::vector<WideNode<W>> nodes;  // nodes[0] is the root; empty for an empty scene
-  std::vector<LeafTriangle> triangles;
-  std::vector<PrimitiveId> ids;
+  std::vector<TrianglePack> packs;
+  std::vector<PrimitiveId> ids;    // one per pack slot
   uint32_t stack_size = 1;  // bounds the traversal stack: (W - 1) per level, plus one
 };
 
