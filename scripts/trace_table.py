@@ -7,9 +7,13 @@ rtcOccluded1 Mrays/s on the very same rays (from the same process), their ratio,
 mismatch count. Example:
 
   scripts/trace_table.py --scenes sponza_dabrovic sibenik conference --builders Q2 Q5 embree-medium lbvh
+
+A builder may carry its own options: --builders "Q2" "Q2 --wide --k 8" --layout bvh8 compares
+the collapsed binary k-means tree with the k-ary one laid out as built.
 """
 import argparse
 import json
+import shlex
 import subprocess
 import sys
 
@@ -31,7 +35,7 @@ def main():
     for scene in args.scenes:
         for threads in args.threads:
             for builder in args.builders:
-                command = [args.kmbvh, "trace", scene, "--builder", builder, "--layout", args.layout, "--count",
+                command = [args.kmbvh, "trace", scene, "--builder", *shlex.split(builder), "--layout", args.layout, "--count",
                            str(args.count), "--threads", str(threads), "--runs", str(args.runs), "--compare-embree",
                            "--json", "-q"]
                 run = subprocess.run(command, capture_output=True, text=True)
@@ -42,7 +46,8 @@ def main():
                 cells = []
                 for k in layout["kinds"]:
                     cells.append(f"{k['kmbvh_mrays_per_s']:.2f} / {k['embree_mrays_per_s']:.2f} ({k['ratio_to_embree']:.2f})")
-                print(f"| {result['scene']} | {result['builder']} | {threads} | " + " | ".join(cells) +
+                name = result["builder"] + (" (k-ary, as built)" if not layout["collapsed"] and args.layout != "bvh2" else "")
+                print(f"| {result['scene']} | {name} | {threads} | " + " | ".join(cells) +
                       f" | {result['mismatches']} |", flush=True)
 
 
