@@ -15,6 +15,7 @@
 #include "adapters/out/tracer.h"
 #include "adapters/rays/hit_compare.h"
 #include "adapters/rays/ray_sets.h"
+#include "support/scenes.h"
 
 namespace kmbvh {
 namespace {
@@ -22,17 +23,6 @@ namespace {
 size_t rays_per_kind() {
   const char* env = std::getenv("KMBVH_TEST_RAYS");
   return env ? std::strtoul(env, nullptr, 10) : 100000;
-}
-
-std::vector<std::string> scene_files() {
-  std::vector<std::string> files;
-  std::error_code ec;
-  for (const auto& entry : std::filesystem::directory_iterator(scene_folder(), ec)) {
-    const std::string ext = entry.path().extension().string();
-    if (ext == ".glb" || ext == ".gltf" || ext == ".obj") files.push_back(entry.path().string());
-  }
-  std::sort(files.begin(), files.end());
-  return files;
 }
 
 // One scene's rays and Embree's answers to them, made once per scene.
@@ -68,7 +58,7 @@ BuilderConfig config_of(const std::string& spec) {
 class EmbreeOracle : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(EmbreeOracle, SameHitsAsEmbreeOnEveryScene) {
-  const auto files = scene_files();
+  const auto files = test::scene_files();
   if (files.empty()) GTEST_SKIP() << "no scenes in " << scene_folder() << " (set KMBVH_SCENES to the shared scene folder)";
   const BuilderConfig config = config_of(GetParam());
   for (const std::string& file : files) {

@@ -8,20 +8,10 @@
 #include "adapters/builder_registry.h"
 #include "adapters/in/load_scene.h"
 #include "adapters/in/scene_folder.h"
+#include "support/scenes.h"
 
 namespace kmbvh {
 namespace {
-
-std::vector<std::string> scene_files() {
-  std::vector<std::string> files;
-  std::error_code ec;
-  for (const auto& entry : std::filesystem::directory_iterator(scene_folder(), ec)) {
-    const std::string ext = entry.path().extension().string();
-    if (ext == ".glb" || ext == ".gltf" || ext == ".obj") files.push_back(entry.path().string());
-  }
-  std::sort(files.begin(), files.end());
-  return files;
-}
 
 const PrimitiveSet& scene_prims(const std::string& path) {
   static std::map<std::string, PrimitiveSet> cache;
@@ -33,7 +23,7 @@ const PrimitiveSet& scene_prims(const std::string& path) {
 class EveryScene : public ::testing::TestWithParam<const char*> {};
 
 TEST_P(EveryScene, TreeIsValid) {
-  const auto files = scene_files();
+  const auto files = test::scene_files();
   if (files.empty()) GTEST_SKIP() << "no scenes in " << scene_folder() << " (set KMBVH_SCENES to the shared scene folder)";
   std::string spec = GetParam();
   BuilderConfig config = parse_builder(spec.substr(0, spec.find('+')));

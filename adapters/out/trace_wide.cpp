@@ -186,8 +186,7 @@ bool finish_hit(const WideBvh<W>& bvh, const Ray& ray, uint32_t found, Hit& hit)
 template <int W, Query query>
 bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit) {
   hit = Hit();
-  if (bvh.nodes.empty() || !ray_is_valid(ray) || !(ray.tnear <= ray.tfar)) return false;
-  if (ray.dir.x == 0.0f && ray.dir.y == 0.0f && ray.dir.z == 0.0f) return false;
+  if (bvh.nodes.empty() || !ray_can_hit(ray)) return false;
   const RayBoxSetup setup(ray);
   const WideRay<W> wray(setup);
   const PackRay pack_ray(ray);

@@ -36,6 +36,11 @@ KMBVH_HD KMBVH_INLINE bool ray_is_valid(const Ray& r) {
   return is_finite(r.org) && is_finite(r.dir) && r.tnear >= 0.0f && !(r.tfar != r.tfar);
 }
 
+// Whether a ray can hit anything at all: valid, a non-empty interval, a direction.
+KMBVH_HD KMBVH_INLINE bool ray_can_hit(const Ray& r) {
+  return ray_is_valid(r) && r.tnear <= r.tfar && !(r.dir.x == 0.0f && r.dir.y == 0.0f && r.dir.z == 0.0f);
+}
+
 // Which query a batch answers: the closest hit, or any hit (occlusion, Embree's rtcOccluded).
 enum class Query : uint8_t { Closest, Any };
 

@@ -34,8 +34,7 @@ KMBVH_HD KMBVH_INLINE bool finish_bvh2_hit(const Bvh2View& view, const Ray& ray,
 KMBVH_HD KMBVH_INLINE bool trace_bvh2(const Bvh2View& view, const Ray& ray, Query query, TraversalEntry* stack,
                                       Hit& hit) {
   hit = Hit();
-  if (view.node_count == 0 || !ray_is_valid(ray) || !(ray.tnear <= ray.tfar)) return false;
-  if (ray.dir.x == 0.0f && ray.dir.y == 0.0f && ray.dir.z == 0.0f) return false;
+  if (view.node_count == 0 || !ray_can_hit(ray)) return false;
   const RayBoxSetup boxes(ray);
   const RayShear shear(ray);
   float tmax = ray.tfar;

@@ -12,18 +12,6 @@
 #include "run_options.h"
 
 namespace kmbvh {
-namespace {
-
-std::vector<std::string> split_list(const std::string& list) {
-  std::vector<std::string> items;
-  std::stringstream in(list);
-  for (std::string item; std::getline(in, item, ',');)
-    if (!item.empty()) items.push_back(item);
-  return items;
-}
-
-}  // namespace
-
 void add_bench_command(CLI::App& app, BenchCommand& c) {
   CLI::App* cmd = app.add_subcommand("bench", "Compare builders on scenes: SAH cost, build time, memory");
   cmd->add_option("scenes", c.scenes,

@@ -1,6 +1,7 @@
 // Options shared by the subcommands that build trees.
 #include <fmt/format.h>
 
+#include <sstream>
 #include <stdexcept>
 
 #include "adapters/builder_registry.h"
@@ -37,6 +38,14 @@ void add_reference_options(CLI::App& cmd, BuilderOptions& o) {
   cmd.add_option("--ploc-radius", o.binary.ploc_radius, "PLOC: neighbours searched on each side");
   cmd.add_option("--treelet-size", o.binary.treelet_size, "ATRBVH: leaves of a restructured treelet");
   cmd.add_option("--treelet-iterations", o.binary.treelet_iterations, "ATRBVH: restructuring passes");
+}
+
+std::vector<std::string> split_list(const std::string& list) {
+  std::vector<std::string> items;
+  std::stringstream in(list);
+  for (std::string item; std::getline(in, item, ',');)
+    if (!item.empty()) items.push_back(item);
+  return items;
 }
 
 void apply_run_options(const RunOptions& run) { set_thread_count(run.threads); }

@@ -11,6 +11,8 @@ void add_builder_options(CLI::App& cmd, BuilderOptions& options);
 // The reference builders' own parameters (PLOC radius, ATRBVH treelets).
 void add_reference_options(CLI::App& cmd, BuilderOptions& options);
 void apply_run_options(const RunOptions& run);
+// "a,b,,c" -> {"a", "b", "c"}: the comma-separated lists of --builders, --layout, --rays.
+std::vector<std::string> split_list(const std::string& list);
 BuilderConfig builder_config(const BuilderOptions& options, const RunOptions& run);
 
 }  // namespace kmbvh

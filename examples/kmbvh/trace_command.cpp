@@ -6,7 +6,6 @@
 #include <chrono>
 #include <nlohmann/json.hpp>
 #include <optional>
-#include <sstream>
 
 #include "adapters/embree/embree_scene.h"
 #include "adapters/out/tracer.h"
@@ -24,18 +23,10 @@ namespace {
 
 using Json = nlohmann::ordered_json;
 
-std::vector<std::string> split(const std::string& list) {
-  std::vector<std::string> out;
-  std::stringstream in(list);
-  for (std::string item; std::getline(in, item, ',');)
-    if (!item.empty()) out.push_back(item);
-  return out;
-}
-
 std::vector<Layout> parse_layouts(const std::string& list) {
   if (list == "all") return {Layout::Bvh2, Layout::Bvh4, Layout::Bvh8};
   std::vector<Layout> out;
-  for (const std::string& name : split(list)) out.push_back(parse_layout(name));
+  for (const std::string& name : split_list(list)) out.push_back(parse_layout(name));
   if (out.empty()) throw std::invalid_argument("--layout: no layout given");
   return out;
 }
@@ -43,7 +34,7 @@ std::vector<Layout> parse_layouts(const std::string& list) {
 std::vector<RayKind> parse_kinds(const std::string& list) {
   if (list == "all") return {RayKind::Primary, RayKind::Shadow, RayKind::Diffuse};
   std::vector<RayKind> out;
-  for (const std::string& name : split(list)) out.push_back(parse_ray_kind(name));
+  for (const std::string& name : split_list(list)) out.push_back(parse_ray_kind(name));
   if (out.empty()) throw std::invalid_argument("--rays: no ray kind given");
   return out;
 }

@@ -1,10 +1,24 @@
 #include "scenes.h"
 
+#include <algorithm>
 #include <cmath>
+#include <filesystem>
 
+#include "adapters/in/scene_folder.h"
 #include "cuda/core/counter_rng.h"
 
 namespace kmbvh::test {
+
+std::vector<std::string> scene_files() {
+  std::vector<std::string> files;
+  std::error_code ec;
+  for (const auto& entry : std::filesystem::directory_iterator(scene_folder(), ec)) {
+    const std::string ext = entry.path().extension().string();
+    if (ext == ".glb" || ext == ".gltf" || ext == ".obj") files.push_back(entry.path().string());
+  }
+  std::sort(files.begin(), files.end());
+  return files;
+}
 
 float random_unit(uint32_t seed, uint32_t stream, uint32_t index) {
   return float(counter_hash(seed, stream, index) >> 8) * (1.0f / 16777216.0f);

@@ -3,6 +3,8 @@
 #pragma once
 
 #include <cstdint>
+#include <string>
+#include <vector>
 
 #include "adapters/in/triangle_scene.h"
 
@@ -17,6 +19,10 @@ TriangleScene clustered_triangles(uint32_t n, uint32_t seed);
 TriangleScene identical_triangles(uint32_t n);           // every triangle the same
 TriangleScene shared_centroid_triangles(uint32_t n);      // nested, all centred on one point
 TriangleScene zero_area_triangles(uint32_t n, uint32_t seed);  // collinear or repeated vertices
+
+// The glTF and OBJ files of the shared scene folder ($KMBVH_SCENES), sorted; empty when
+// the folder is absent.
+std::vector<std::string> scene_files();
 
 float random_unit(uint32_t seed, uint32_t stream, uint32_t index);  // uniform in [0, 1)
 
