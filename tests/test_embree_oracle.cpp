@@ -86,12 +86,7 @@ TEST_P(EmbreeOracle, SameHitsAsEmbreeOnEveryScene) {
 INSTANTIATE_TEST_SUITE_P(Builders, EmbreeOracle,
                          ::testing::Values("sweep-sah", "lbvh", "hlbvh", "atrbvh", "ploc", "Q1", "Q2", "Q3", "Q4", "Q5",
                                            "Q2+wide4", "Q2+wide8", "embree-low", "embree-medium", "embree-high"),
-                         [](const auto& info) {
-                           std::string name = info.param;
-                           for (char& c : name)
-                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-                           return name;
-                         });
+                         [](const auto& info) { return test::test_name(info.param); });
 
 }  // namespace
 }  // namespace kmbvh

@@ -42,12 +42,7 @@ INSTANTIATE_TEST_SUITE_P(Scenes, EveryScene,
                          ::testing::Values("sweep-sah", "lbvh", "hlbvh", "atrbvh", "ploc", "Q1", "Q2", "Q3", "Q4", "Q5",
                                            "Q2+medians", "Q3+wide", "Q2+levels", "embree-low",
                                            "embree-medium", "embree-high"),
-                         [](const auto& info) {
-                           std::string name = info.param;
-                           for (char& c : name)
-                             if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
-                           return name;
-                         });
+                         [](const auto& info) { return test::test_name(info.param); });
 
 }  // namespace
 }  // namespace kmbvh

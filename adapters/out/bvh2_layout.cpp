@@ -1,9 +1,10 @@
 #include "bvh2_layout.h"
 
-#include <algorithm>
 #include <stdexcept>
 #include <string>
 #include <utility>
+
+#include "depth_first.h"
 
 namespace kmbvh {
 namespace {
@@ -38,28 +39,17 @@ Bvh2 make_bvh2(const Bvh& bvh, LeafTriangles triangles) {
     return out;
   }
 
-  // Depth-first: each interior node is written when first reached; its interior children
-  // get their indices as they are written, so the parent is patched afterwards.
-  struct Pending {
-    uint32_t bvh_node, parent, slot, depth;
-  };
-  std::vector<Pending> stack{{0, UINT32_MAX, 0, 1}};
-  uint32_t max_depth = 1;
-  while (!stack.empty()) {
-    const Pending p = stack.back();
-    stack.pop_back();
-    const BvhNode& n = bvh.nodes[p.bvh_node];
-    if (n.count != 2) throw std::invalid_argument("a BVH2 layout needs a binary tree (a node has " + std::to_string(n.count) + " children)");
-    const uint32_t index = uint32_t(out.nodes.size());
-    out.nodes.emplace_back();
-    if (p.parent != UINT32_MAX) out.nodes[p.parent].ref[p.slot] = index;
-    max_depth = std::max(max_depth, p.depth);
-    for (int c = 1; c >= 0; --c) {  // left child popped first, so it follows its parent
-      const BvhNode& child = bvh.nodes[n.first + c];
-      set_child(out.nodes[index], c, child, 0);
-      if (!child.is_leaf()) stack.push_back({n.first + uint32_t(c), index, uint32_t(c), p.depth + 1});
-    }
-  }
+  const uint32_t max_depth = lay_out_depth_first(
+      bvh,
+      [&](const BvhNode& n, uint32_t) {
+        if (n.count != 2)
+          throw std::invalid_argument("a BVH2 layout needs a binary tree (a node has " + std::to_string(n.count) + " children)");
+        Bvh2Node node;
+        for (int c = 0; c < 2; ++c) set_child(node, c, bvh.nodes[n.first + c], 0);  // interior refs linked below
+        out.nodes.push_back(node);
+        return uint32_t(out.nodes.size() - 1);
+      },
+      [&](uint32_t parent, uint32_t slot, uint32_t index) { out.nodes[parent].ref[slot] = index; });
   out.stack_size = max_depth + 1;
   return out;
 }

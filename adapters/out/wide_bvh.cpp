@@ -1,13 +1,13 @@
 #include "wide_bvh.h"
 
-#include "cuda/traversal/ray.h"
-
-#include <algorithm>
 #include <cfloat>
 #include <limits>
 #include <stdexcept>
 #include <string>
 #include <utility>
+
+#include "cuda/traversal/ray.h"
+#include "depth_first.h"
 
 namespace kmbvh {
 namespace {
@@ -72,28 +72,18 @@ WideBvh<W> make_wide_bvh(const Bvh& bvh, LeafTriangles triangles) {
     set_lane(out, out.nodes[0], 0, bvh.root(), triangles);
     return out;
   }
-  struct Pending {
-    uint32_t bvh_node, parent, lane, depth;
-  };
-  std::vector<Pending> stack{{0, UINT32_MAX, 0, 1}};
-  uint32_t max_depth = 1;
-  while (!stack.empty()) {
-    const Pending p = stack.back();
-    stack.pop_back();
-    const BvhNode& n = bvh.nodes[p.bvh_node];
-    if (n.count > W)
-      throw std::invalid_argument("a " + std::to_string(W) + "-wide layout got a node of " + std::to_string(n.count) +
-                                  " children");
-    const uint32_t index = uint32_t(out.nodes.size());
-    out.nodes.push_back(empty_node<W>());
-    if (p.parent != UINT32_MAX) out.nodes[p.parent].ref[p.lane] = index;
-    max_depth = std::max(max_depth, p.depth);
-    for (int c = int(n.count) - 1; c >= 0; --c) {
-      const BvhNode& child = bvh.nodes[n.first + c];
-      set_lane(out, out.nodes[index], c, child, triangles);
-      if (!child.is_leaf()) stack.push_back({n.first + uint32_t(c), index, uint32_t(c), p.depth + 1});
-    }
-  }
+  const uint32_t max_depth = lay_out_depth_first(
+      bvh,
+      [&](const BvhNode& n, uint32_t) {
+        if (n.count > W)
+          throw std::invalid_argument("a " + std::to_string(W) + "-wide layout got a node of " + std::to_string(n.count) +
+                                      " children");
+        WideNode<W> node = empty_node<W>();
+        for (uint32_t c = 0; c < n.count; ++c) set_lane(out, node, int(c), bvh.nodes[n.first + c], triangles);
+        out.nodes.push_back(node);
+        return uint32_t(out.nodes.size() - 1);
+      },
+      [&](uint32_t parent, uint32_t lane, uint32_t index) { out.nodes[parent].ref[lane] = index; });
   out.stack_size = (W - 1) * max_depth + 1;
   return out;
 }

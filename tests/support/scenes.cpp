@@ -1,6 +1,7 @@
 #include "scenes.h"
 
 #include <algorithm>
+#include <cctype>
 #include <cmath>
 #include <filesystem>
 
@@ -18,6 +19,13 @@ std::vector<std::string> scene_files() {
   }
   std::sort(files.begin(), files.end());
   return files;
+}
+
+std::string test_name(const std::string& spec) {
+  std::string name = spec;
+  for (char& c : name)
+    if (!std::isalnum(static_cast<unsigned char>(c))) c = '_';
+  return name;
 }
 
 float random_unit(uint32_t seed, uint32_t stream, uint32_t index) {

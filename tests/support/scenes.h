@@ -24,6 +24,9 @@ TriangleScene zero_area_triangles(uint32_t n, uint32_t seed);  // collinear or r
 // the folder is absent.
 std::vector<std::string> scene_files();
 
+// A builder spec ("Q2+wide4") as a GoogleTest parameter name ("Q2_wide4").
+std::string test_name(const std::string& spec);
+
 float random_unit(uint32_t seed, uint32_t stream, uint32_t index);  // uniform in [0, 1)
 
 }  // namespace kmbvh::test
