@@ -146,8 +146,8 @@ inline int intersect_pack(const TrianglePack& p, const PackRay& r, float tnear, 
   const vip valid = ~(negative & positive) & (det != zero) & (abs_T > (vfp{} + tnear) * abs_det) &
                     (abs_T <= (vfp{} + tmax) * abs_det);
   const vip exact_zero = (U == zero) | (V == zero) | (W == zero);
-  unsigned hits = (pack_mask(valid & ~exact_zero));
-  unsigned redo = (pack_mask(exact_zero));
+  unsigned hits = pack_mask(valid & ~exact_zero);
+  unsigned redo = pack_mask(exact_zero);
   int best = -1;
   if (hits) {
     const vfp t = T / det;

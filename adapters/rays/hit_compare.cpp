@@ -4,6 +4,8 @@
 #include <cmath>
 #include <limits>
 
+#include "cuda/traversal/watertight.h"
+
 namespace kmbvh {
 namespace {
 
@@ -28,13 +30,16 @@ double t_scale(const Ray& ray, double t) {
   const double d = std::sqrt(double(dot(ray.dir, ray.dir)));
   return std::max(std::fabs(t), d > 0 ? o / d : 0.0);
 }
+
 // How the ray meets one triangle, in double precision: not at all, on an edge or an end
 // of the interval (within tolerance: rounding decides), or clearly.
 enum class Meet { None, Edge, Clear };
 
 Meet meet(const TriangleScene& scene, uint32_t prim, const Ray& ray, double& t, double* uv = nullptr) {
   const Triangle& tri = scene.triangles[prim];
-  const D3 a = d3(scene.positions[tri[0]]), b = d3(scene.positions[tri[1]]), c = d3(scene.positions[tri[2]]);
+  const Vec3 fa = scene.positions[tri[0]], fb = scene.positions[tri[1]], fc = scene.positions[tri[2]];
+  if (is_degenerate_triangle(fa, fb, fc)) return Meet::None;  // never hit, by either system
+  const D3 a = d3(fa), b = d3(fb), c = d3(fc);
   const D3 o = d3(ray.org), d = d3(ray.dir);
   const D3 e1 = sub(b, a), e2 = sub(c, a), p = cross(d, e2);
   const double det = dot(e1, p);
