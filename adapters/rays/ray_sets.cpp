@@ -94,13 +94,15 @@ RaySets make_ray_sets(const TriangleScene& scene, size_t count, uint32_t seed, c
     const Vec3 origin = p.position + p.normal * offset;
 
     const Vec3 target = light + Vec3(counter_unit(seed, kLightJitter, uint32_t(i)) - 0.5f, 0.0f, 0.0f) * (0.02f * diagonal);
-    Ray shadow;
-    shadow.org = origin;
     const Vec3 to_light = target - origin;
     const float distance = length(to_light);
-    shadow.dir = to_light * (1.0f / distance);
-    shadow.tfar = distance * (1.0f - 1e-4f);
-    sets.shadow.push_back(shadow);
+    if (distance > 0.0f) {  // else the point is the light itself: no shadow ray to make
+      Ray shadow;
+      shadow.org = origin;
+      shadow.dir = to_light * (1.0f / distance);
+      shadow.tfar = distance * (1.0f - 1e-4f);
+      sets.shadow.push_back(shadow);
+    }
 
     Ray diffuse;
     diffuse.org = origin;
