@@ -14,7 +14,8 @@
 #include "adapters/out/collapse_wide.h"
 #include "adapters/out/tracer.h"
 #include "adapters/rays/hit_compare.h"
-#include "adapters/rays/ray_sets.h"
+#include "adapters/rays/scene_rays.h"
+#include "support/builder_specs.h"
 #include "support/scenes.h"
 
 namespace kmbvh {
@@ -37,22 +38,11 @@ Oracle make_oracle(const std::string& file) {
   Oracle o;
   o.scene = load_scene_file(file);
   o.prims = make_primitive_set(o.scene);
-  const Tracer helper(run_builder(parse_builder("lbvh"), o.prims), o.prims, o.scene, Layout::Bvh2);
-  o.rays = make_ray_sets(o.scene, rays_per_kind(), 7,
-                         [&](const std::vector<Ray>& r, std::vector<Hit>& h) { helper.trace(r, Query::Closest, h); });
+  o.rays = scene_ray_sets(o.scene, o.prims, rays_per_kind(), 7);
   const EmbreeScene embree(o.scene);
   for (const RayKind kind : {RayKind::Primary, RayKind::Shadow, RayKind::Diffuse})
     embree.trace(o.rays.of(kind), query_for(kind), EmbreeRays::Single, o.embree[int(kind)]);
   return o;
-}
-
-BuilderConfig config_of(const std::string& spec) {
-  BuilderConfig c = parse_builder(spec.substr(0, spec.find('+')));
-  if (spec.find("+wide") != std::string::npos) {
-    c.kmeans.wide = true;
-    c.kmeans.k = spec.back() == '4' ? 4 : 8;
-  }
-  return c;
 }
 
 class EmbreeOracle : public ::testing::TestWithParam<const char*> {};
@@ -60,7 +50,7 @@ class EmbreeOracle : public ::testing::TestWithParam<const char*> {};
 TEST_P(EmbreeOracle, SameHitsAsEmbreeOnEveryScene) {
   const auto files = test::scene_files();
   if (files.empty()) GTEST_SKIP() << "no scenes in " << scene_folder() << " (set KMBVH_SCENES to the shared scene folder)";
-  const BuilderConfig config = config_of(GetParam());
+  const BuilderConfig config = test::config_from_spec(GetParam());
   for (const std::string& file : files) {
     const Oracle o = make_oracle(file);
     ASSERT_GT(o.rays.primary.size(), 0u) << file;

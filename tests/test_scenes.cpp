@@ -8,6 +8,7 @@
 #include "adapters/builder_registry.h"
 #include "adapters/in/load_scene.h"
 #include "adapters/in/scene_folder.h"
+#include "support/builder_specs.h"
 #include "support/scenes.h"
 
 namespace kmbvh {
@@ -25,11 +26,7 @@ class EveryScene : public ::testing::TestWithParam<const char*> {};
 TEST_P(EveryScene, TreeIsValid) {
   const auto files = test::scene_files();
   if (files.empty()) GTEST_SKIP() << "no scenes in " << scene_folder() << " (set KMBVH_SCENES to the shared scene folder)";
-  std::string spec = GetParam();
-  BuilderConfig config = parse_builder(spec.substr(0, spec.find('+')));
-  if (spec.find("+medians") != std::string::npos) config.kmeans.metric = ClusterMetric::Medians;
-  if (spec.find("+wide") != std::string::npos) config.kmeans.wide = true;
-  if (spec.find("+levels") != std::string::npos) config.kmeans.cpu_subtrees = false;  // the GPU's path
+  const BuilderConfig config = test::config_from_spec(GetParam());
   for (const std::string& file : files) {
     const PrimitiveSet& prims = scene_prims(file);
     const Bvh bvh = run_builder(config, prims);

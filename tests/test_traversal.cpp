@@ -13,6 +13,7 @@
 #include "adapters/rays/hit_compare.h"
 #include "cuda/metrics/validate.h"
 #include "cuda/traversal/watertight.h"
+#include "support/builder_specs.h"
 #include "support/rays.h"
 #include "support/scenes.h"
 
@@ -27,7 +28,7 @@ std::vector<Hit> brute_force(const TriangleScene& scene, const std::vector<Ray>&
   std::vector<Hit> hits(rays.size());
   for (size_t r = 0; r < rays.size(); ++r) {
     const Ray& ray = rays[r];
-    if (!ray_is_valid(ray) || !(ray.tnear <= ray.tfar)) continue;
+    if (!ray_can_hit(ray)) continue;
     const RayShear shear(ray);
     float tmax = ray.tfar;
     uint32_t best = kInvalidId;
@@ -61,18 +62,6 @@ std::vector<Ray> test_rays(const TriangleScene& scene, uint32_t n, uint32_t seed
   return rays;
 }
 
-struct Case {
-  std::string spec;  // builder, as parse_builder reads it, "+wide4"/"+wide8" for k-means' k-ary tree
-  BuilderConfig config() const {
-    BuilderConfig c = parse_builder(spec.substr(0, spec.find('+')));
-    if (spec.find("+wide") != std::string::npos) {
-      c.kmeans.wide = true;
-      c.kmeans.k = spec.back() == '4' ? 4 : 8;
-    }
-    return c;
-  }
-};
-
 std::vector<Layout> layouts_for(const Bvh& bvh) {
   const uint32_t arity = tree_arity(bvh);
   std::vector<Layout> out;
@@ -86,7 +75,7 @@ void expect_layouts_match_brute_force(const TriangleScene& scene, const std::vec
   const std::vector<Hit> closest = brute_force(scene, rays, Query::Closest);
   for (const char* spec : {"sweep-sah", "lbvh", "hlbvh", "atrbvh", "ploc", "Q1", "Q3", "Q5", "embree-low", "embree-medium",
                            "Q2+wide4", "Q2+wide8"}) {
-    const BuilderConfig config = Case{spec}.config();
+    const BuilderConfig config = test::config_from_spec(spec);
     const Bvh bvh = run_builder(config, prims);
     for (const Layout layout : layouts_for(bvh)) {
       const Tracer tracer(bvh, prims, scene, layout);

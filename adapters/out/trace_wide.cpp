@@ -16,19 +16,8 @@ typedef float vf4 __attribute__((vector_size(16)));
 typedef float vf8 __attribute__((vector_size(32)));
 typedef int vi4 __attribute__((vector_size(16)));
 typedef int vi8 __attribute__((vector_size(32)));
-// The pack's vector types: as many lanes as a TrianglePack has slots.
-using vfp = std::conditional_t<kPackWidth == 8, vf8, vf4>;
-using vip = std::conditional_t<kPackWidth == 8, vi8, vi4>;
-inline unsigned pack_mask(vi4 m) { return unsigned(_mm_movemask_ps(__m128(m))); }
-inline unsigned pack_mask(vi8 m) {
-#if defined(__AVX__)
-  return unsigned(_mm256_movemask_ps(__m256(m)));
-#else
-  unsigned bits = 0;
-  for (int i = 0; i < 8; ++i) bits |= unsigned(m[i] != 0) << i;
-  return bits;
-#endif
-}
+
+// W lanes of floats, for nodes of W children and packs of W triangles.
 template <int W>
 struct Lanes;
 template <>
@@ -39,6 +28,8 @@ template <>
 struct Lanes<8> {
   using V = vf8;
 };
+using vfp = Lanes<kPackWidth>::V;  // a pack's lanes
+using vip = std::conditional_t<kPackWidth == 8, vi8, vi4>;
 
 template <typename V>
 inline V vmin(V a, V b) {
@@ -49,14 +40,15 @@ inline V vmax(V a, V b) {
   return a < b ? b : a;
 }
 
-inline unsigned lane_mask(vf4 entry, vf4 exit) { return unsigned(_mm_movemask_ps(_mm_cmple_ps(__m128(entry), __m128(exit)))); }
-inline unsigned lane_mask(vf8 entry, vf8 exit) {
+// One bit per lane of a comparison's result.
+inline unsigned mask_bits(vi4 m) { return unsigned(_mm_movemask_ps(__m128(m))); }
+inline unsigned mask_bits(vi8 m) {
 #if defined(__AVX__)
-  return unsigned(_mm256_movemask_ps(_mm256_cmp_ps(__m256(entry), __m256(exit), _CMP_LE_OQ)));
+  return unsigned(_mm256_movemask_ps(__m256(m)));
 #else
-  unsigned m = 0;
-  for (int i = 0; i < 8; ++i) m |= unsigned(entry[i] <= exit[i]) << i;
-  return m;
+  unsigned bits = 0;
+  for (int i = 0; i < 8; ++i) bits |= unsigned(m[i] != 0) << i;
+  return bits;
 #endif
 }
 
@@ -96,16 +88,10 @@ inline unsigned enter_children(const WideNode<W>& n, const WideRay<W>& r, float 
     t1 = vmin(t1, (load<W>(planes + r.far_plane[d]) - r.org[d]) * r.inv[d]);
   }
   entry = t0;
-  return lane_mask(t0, t1 * kRobustExit);
+  return mask_bits(t0 <= t1 * kRobustExit);
 }
 
-inline vfp load4(const float* p) {
-  vfp v;
-  std::memcpy(&v, p, sizeof(v));
-  return v;
-}
-
-// The watertight test's per-ray set-up, broadcast to the four slots of a pack.
+// The watertight test's per-ray set-up, broadcast to the slots of a pack.
 struct PackRay {
   RayShear shear;
   vfp org[3];  // the origin's kx, ky, kz components
@@ -120,7 +106,7 @@ struct PackRay {
   }
 };
 
-// The watertight test (cuda/traversal/watertight.h) on four triangles at once, in the
+// The watertight test (cuda/traversal/watertight.h) on a pack of triangles at once, in the
 // same operations as the scalar test. Returns the slot of the nearest hit in (tnear,
 // tmax] and its t, or -1. A slot whose edge functions come out exactly zero goes to the
 // scalar test, which redoes them in double precision.
@@ -128,8 +114,8 @@ inline int intersect_pack(const TrianglePack& p, const PackRay& r, float tnear, 
   const RayShear& s = r.shear;
   vfp x[3], y[3], z[3];
   for (int v = 0; v < 3; ++v) {
-    const vfp dx = load4(p.v[v][s.kx]) - r.org[0], dy = load4(p.v[v][s.ky]) - r.org[1];
-    z[v] = load4(p.v[v][s.kz]) - r.org[2];
+    const vfp dx = load<kPackWidth>(p.v[v][s.kx]) - r.org[0], dy = load<kPackWidth>(p.v[v][s.ky]) - r.org[1];
+    z[v] = load<kPackWidth>(p.v[v][s.kz]) - r.org[2];
     x[v] = dx - r.sx * z[v];
     y[v] = dy - r.sy * z[v];
   }
@@ -146,8 +132,8 @@ inline int intersect_pack(const TrianglePack& p, const PackRay& r, float tnear, 
   const vip valid = ~(negative & positive) & (det != zero) & (abs_T > (vfp{} + tnear) * abs_det) &
                     (abs_T <= (vfp{} + tmax) * abs_det);
   const vip exact_zero = (U == zero) | (V == zero) | (W == zero);
-  unsigned hits = pack_mask(valid & ~exact_zero);
-  unsigned redo = pack_mask(exact_zero);
+  unsigned hits = mask_bits(valid & ~exact_zero);
+  unsigned redo = mask_bits(exact_zero);
   int best = -1;
   if (hits) {
     const vfp t = T / det;

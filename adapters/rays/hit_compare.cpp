@@ -90,6 +90,19 @@ bool meets_at(const TriangleScene& scene, const Ray& ray, const Hit& h) {
   return h.primID < scene.triangles.size() && meet(scene, h.primID, ray, t) != Meet::None && same_t(ray, t, h.t);
 }
 
+// The count a mismatch of this kind adds to (never None: those are not mismatches).
+size_t& count_of(HitComparison& c, Difference kind) {
+  switch (kind) {
+    case Difference::HitMiss: return c.hit_miss;
+    case Difference::Distance: return c.distance;
+    case Difference::Primitive: return c.primitive;
+    case Difference::Normal: return c.normal;
+    case Difference::Barycentrics:
+    case Difference::None: break;
+  }
+  return c.barycentrics;
+}
+
 bool normals_differ(Vec3 a, Vec3 b) {
   const float scale = std::max({std::fabs(b.x), std::fabs(b.y), std::fabs(b.z), 1e-30f});
   return std::fabs(a.x - b.x) > kRelNormal * scale || std::fabs(a.y - b.y) > kRelNormal * scale ||
@@ -97,6 +110,18 @@ bool normals_differ(Vec3 a, Vec3 b) {
 }
 
 }  // namespace
+
+const char* to_string(Difference kind) {
+  switch (kind) {
+    case Difference::HitMiss: return "hit_miss";
+    case Difference::Distance: return "distance";
+    case Difference::Primitive: return "primitive";
+    case Difference::Normal: return "normal";
+    case Difference::Barycentrics: return "barycentrics";
+    case Difference::None: break;
+  }
+  return "none";
+}
 
 void HitComparison::add(const HitComparison& o, size_t keep) {
   rays += o.rays;
@@ -123,22 +148,22 @@ HitComparison compare_hits(const TriangleScene& scene, const std::vector<Ray>& r
     const Hit& b = reference[i];
     out.hits += b.found();
     if (!ray_is_valid(ray)) ++out.skipped;
-    const char* kind = nullptr;
+    Difference kind = Difference::None;
     if (a.found() != b.found()) {
-      kind = "hit_miss";
+      kind = Difference::HitMiss;
     } else if (a.found() && query == Query::Closest) {
       if (!same_t(ray, a.t, b.t))
-        kind = "distance";
+        kind = Difference::Distance;
       else if (a.geomID != b.geomID || a.primID != b.primID)
-        kind = "primitive";
+        kind = Difference::Primitive;
       else if (normals_differ(a.Ng, b.Ng))
-        kind = "normal";
+        kind = Difference::Normal;
       else if (std::fabs(a.u - b.u) > kBarycentric || std::fabs(a.v - b.v) > kBarycentric)
-        kind = "barycentrics";
+        kind = Difference::Barycentrics;
     }
-    if (!kind) continue;
+    if (kind == Difference::None) continue;
     const bool same_prim = a.found() && b.found() && a.geomID == b.geomID && a.primID == b.primID;
-    if (same_prim && kind[0] != 'n' && a.primID < scene.triangles.size()) {
+    if (same_prim && kind != Difference::Normal && a.primID < scene.triangles.size()) {
       // Same triangle, numbers apart: whose are right? Embree's float t, u, v drift on
       // thin triangles seen edge-on; kmbvh's are refined in double precision.
       double t, uv[2];
@@ -148,14 +173,14 @@ HitComparison compare_hits(const TriangleScene& scene, const std::vector<Ray>& r
         continue;
       }
     }
-    if (kind[0] == 'p' && meets_at(scene, ray, a) && meets_at(scene, ray, b)) {
+    if (kind == Difference::Primitive && meets_at(scene, ray, a) && meets_at(scene, ray, b)) {
       // Both found a triangle at the same distance (a shared edge or vertex, or coplanar
       // overlapping faces): two independent systems agree on the distance, so either
       // primitive is right, without a brute-force search for a nearer one.
       ++out.edge_ties;
       continue;
     }
-    const bool geometric = !same_prim && (kind[0] == 'h' || kind[0] == 'd');
+    const bool geometric = !same_prim && (kind == Difference::HitMiss || kind == Difference::Distance);
     if (geometric && ray_is_valid(ray)) {
       const Ground g = brute_force(scene, ray);
       if (acceptable(scene, ray, query, a, g) && acceptable(scene, ray, query, b, g)) {
@@ -163,13 +188,8 @@ HitComparison compare_hits(const TriangleScene& scene, const std::vector<Ray>& r
         continue;
       }
     }
-    const std::string k = kind;
-    if (k == "hit_miss") ++out.hit_miss;
-    else if (k == "distance") ++out.distance;
-    else if (k == "primitive") ++out.primitive;
-    else if (k == "normal") ++out.normal;
-    else ++out.barycentrics;
-    if (out.first.size() < keep) out.first.push_back(RayMismatch{i, k, ray, a, b});
+    ++count_of(out, kind);
+    if (out.first.size() < keep) out.first.push_back(RayMismatch{i, to_string(kind), ray, a, b});
   }
   return out;
 }

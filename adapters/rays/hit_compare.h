@@ -16,6 +16,10 @@
 
 namespace kmbvh {
 
+// How two answers to one ray differ, in the order they are checked.
+enum class Difference { None, HitMiss, Distance, Primitive, Normal, Barycentrics };
+const char* to_string(Difference kind);  // "hit_miss", "distance", ...
+
 struct RayMismatch {
   size_t index = 0;  // position of the ray in its set
   std::string kind;  // "hit_miss", "distance", "primitive", "normal", "barycentrics"

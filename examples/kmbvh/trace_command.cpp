@@ -10,7 +10,7 @@
 #include "adapters/embree/embree_scene.h"
 #include "adapters/out/tracer.h"
 #include "adapters/rays/hit_compare.h"
-#include "adapters/rays/ray_sets.h"
+#include "adapters/rays/scene_rays.h"
 #include "commands.h"
 #include "cuda/core/threads.h"
 #include "cuda/metrics/sah.h"
@@ -122,13 +122,8 @@ int run_trace(const TraceCommand& c) {
   prepare_builder(config);
   const Bvh bvh = run_builder(config, scene.prims);
 
-  // The rays do not depend on the builder under test: primary hits come from an LBVH of
-  // the scene, so every builder and layout is traced on the very same rays.
   progress.update("making rays");
-  const Bvh helper_tree = run_builder(parse_builder("lbvh"), scene.prims);
-  const Tracer helper(helper_tree, scene.prims, scene.geometry, Layout::Bvh2);
-  const RaySets rays = make_ray_sets(scene.geometry, c.count, c.ray_seed,
-                                     [&](const std::vector<Ray>& r, std::vector<Hit>& h) { helper.trace(r, Query::Closest, h); });
+  const RaySets rays = scene_ray_sets(scene.geometry, scene.prims, c.count, c.ray_seed);
 
   std::optional<EmbreeScene> embree;
   std::vector<EmbreeResult> embree_results(3);
