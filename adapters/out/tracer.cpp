@@ -12,6 +12,7 @@ namespace kmbvh {
 
 struct Tracer::Layouts {
   Bvh2 bvh2;
+  std::unique_ptr<Bvh2OnGpu> bvh2_gpu;  // with the CUDA backend: bvh2, resident on the device
   WideBvh<4> bvh4;
   WideBvh<8> bvh8;
 };
@@ -34,7 +35,7 @@ Layout parse_layout(const std::string& name) {
 uint32_t layout_width(Layout layout) { return layout == Layout::Bvh2 ? 2 : layout == Layout::Bvh4 ? 4 : 8; }
 
 Tracer::Tracer(const Bvh& bvh, const PrimitiveSet& prims, const TriangleScene& scene, Layout layout, Backend backend)
-    : layout_(layout), backend_(backend), layouts_(std::make_unique<Layouts>()) {
+    : layout_(layout), layouts_(std::make_unique<Layouts>()) {
   if (backend == Backend::Cuda && layout != Layout::Bvh2)
     throw std::invalid_argument("the CUDA traversal reads the bvh2 layout; bvh4 and bvh8 are CPU SIMD layouts");
   require_backend(backend);
@@ -48,7 +49,10 @@ Tracer::Tracer(const Bvh& bvh, const PrimitiveSet& prims, const TriangleScene& s
   tree_ = collapsed_ ? collapse_to_width(bvh, width) : bvh;
   LeafTriangles triangles = leaf_triangles(tree_, prims, scene);
   switch (layout) {
-    case Layout::Bvh2: layouts_->bvh2 = make_bvh2(tree_, std::move(triangles)); break;
+    case Layout::Bvh2:
+      layouts_->bvh2 = make_bvh2(tree_, std::move(triangles));
+      if (backend == Backend::Cuda) layouts_->bvh2_gpu = std::make_unique<Bvh2OnGpu>(layouts_->bvh2);
+      break;
     case Layout::Bvh4: layouts_->bvh4 = make_wide_bvh<4>(tree_, std::move(triangles)); break;
     case Layout::Bvh8: layouts_->bvh8 = make_wide_bvh<8>(tree_, std::move(triangles)); break;
   }
@@ -60,11 +64,16 @@ Tracer::Tracer(Tracer&&) noexcept = default;
 
 void Tracer::trace(const std::vector<Ray>& rays, Query query, std::vector<Hit>& hits) const {
   switch (layout_) {
-    case Layout::Bvh2: return trace_bvh2(layouts_->bvh2, rays, query, hits, backend_);
+    case Layout::Bvh2:
+      if (!layouts_->bvh2_gpu) return trace_bvh2(layouts_->bvh2, rays, query, hits);
+      hits.resize(rays.size());
+      return layouts_->bvh2_gpu->trace(rays.data(), rays.size(), query, hits.data());
     case Layout::Bvh4: return trace_wide(layouts_->bvh4, rays, query, hits);
     case Layout::Bvh8: return trace_wide(layouts_->bvh8, rays, query, hits);
   }
 }
+
+double Tracer::last_kernel_ms() const { return layouts_->bvh2_gpu ? layouts_->bvh2_gpu->last_kernel_ms() : 0.0; }
 
 template <int W>
 size_t wide_bytes(const WideBvh<W>& b) {

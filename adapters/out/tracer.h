@@ -39,11 +39,12 @@ class Tracer {
   double layout_ms() const { return layout_ms_; }
   size_t layout_bytes() const;
   uint32_t stack_size() const;
+  // With the CUDA backend, the last trace()'s kernel time without transfers; 0 on the CPU.
+  double last_kernel_ms() const;
 
  private:
   struct Layouts;
   Layout layout_;
-  Backend backend_;
   Bvh tree_;
   bool collapsed_ = false;
   double layout_ms_ = 0;

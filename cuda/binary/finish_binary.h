@@ -63,10 +63,8 @@ inline Bvh lay_out(const BinaryTreeView& tree, CollapseView view, const uint32_t
   }
   Bvh bvh;
   bvh.nodes = to_host(nodes, nodes.size());
-  if (range_first)
-    bvh.prim_indices.assign(tree.order, tree.order + n);
-  else
-    bvh.prim_indices = to_host(prim_indices, n);
+  // tree.order is backend memory: on the GPU it must be copied, never read from the host.
+  bvh.prim_indices = range_first ? to_host(static_cast<const uint32_t*>(tree.order), n) : to_host(prim_indices, n);
   return bvh;
 }
 

@@ -63,15 +63,21 @@ void for_each_index(uint32_t n, const F& f) {
   if (n > 0) thrust::for_each_n(thrust::device, thrust::counting_iterator<uint32_t>(0), n, f);
 }
 
+// n elements from backend memory (a raw pointer into a Buffer) to a host vector.
 template <typename T>
-std::vector<T> to_host(Buffer<T>& b, size_t n) {
+std::vector<T> to_host(const T* p, size_t n) {
 #if KMBVH_BACKEND_CPU
-  return std::vector<T>(ptr(b), ptr(b) + n);  // host memory already: one pass, no zero fill
+  return std::vector<T>(p, p + n);  // host memory already: one pass, no zero fill
 #else
   std::vector<T> h(n);
-  thrust::copy(b.begin(), b.begin() + n, h.begin());
+  thrust::copy(thrust::device_pointer_cast(p), thrust::device_pointer_cast(p) + n, h.begin());
   return h;
 #endif
+}
+
+template <typename T>
+std::vector<T> to_host(Buffer<T>& b, size_t n) {
+  return to_host(static_cast<const T*>(ptr(b)), n);
 }
 
 // The input boxes as the backend reads them: the PrimitiveSet's own memory on the CPU

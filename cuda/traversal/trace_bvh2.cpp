@@ -10,11 +10,17 @@ void trace_bvh2(const Bvh2& bvh, const std::vector<Ray>& rays, Query query, std:
                 Backend backend) {
   require_backend(backend);
   hits.resize(rays.size());
-#if defined(KMBVH_HAS_CUDA)
-  if (backend == Backend::Cuda) return detail::trace_bvh2_gpu(bvh, rays.data(), rays.size(), query, hits.data());
-#endif
+  if (backend == Backend::Cuda) return Bvh2OnGpu(bvh).trace(rays.data(), rays.size(), query, hits.data());
   detail::trace_bvh2_cpu(bvh.view(), rays.data(), rays.size(), query, hits.data());
 }
+
+#if !defined(KMBVH_HAS_CUDA)
+// Without the CUDA backend there is nothing to copy to: require_backend() has thrown already.
+struct Bvh2OnGpu::Impl {};
+Bvh2OnGpu::Bvh2OnGpu(const Bvh2&) { require_backend(Backend::Cuda); }
+Bvh2OnGpu::~Bvh2OnGpu() = default;
+void Bvh2OnGpu::trace(const Ray*, size_t, Query, Hit*) { require_backend(Backend::Cuda); }
+#endif
 
 namespace detail {
 

@@ -2,6 +2,7 @@
 // the CPU (OpenMP threads, each with its own stack) or the GPU (one thread per ray).
 #pragma once
 
+#include <memory>
 #include <vector>
 
 #include "bvh2.h"
@@ -27,9 +28,28 @@ struct Bvh2 {
 void trace_bvh2(const Bvh2& bvh, const std::vector<Ray>& rays, Query query, std::vector<Hit>& hits,
                 Backend backend = Backend::Cpu);
 
+// A Bvh2 copied to the GPU once, for many batches of rays: each batch goes up, is traced
+// one thread per ray, and its hits come back; the device buffers are kept between batches.
+// Throws std::runtime_error when the CUDA backend is not compiled in or finds no device.
+class Bvh2OnGpu {
+ public:
+  explicit Bvh2OnGpu(const Bvh2& bvh);
+  ~Bvh2OnGpu();
+  Bvh2OnGpu(const Bvh2OnGpu&) = delete;
+  Bvh2OnGpu& operator=(const Bvh2OnGpu&) = delete;
+
+  void trace(const Ray* rays, size_t n, Query query, Hit* hits);
+  // The last trace()'s kernel time alone, without the rays' and hits' transfers.
+  double last_kernel_ms() const { return last_kernel_ms_; }
+
+ private:
+  double last_kernel_ms_ = 0;
+  struct Impl;
+  std::unique_ptr<Impl> impl_;
+};
+
 namespace detail {
 void trace_bvh2_cpu(const Bvh2View& view, const Ray* rays, size_t n, Query query, Hit* hits);
-void trace_bvh2_gpu(const Bvh2& bvh, const Ray* rays, size_t n, Query query, Hit* hits);
 }  // namespace detail
 
 }  // namespace kmbvh

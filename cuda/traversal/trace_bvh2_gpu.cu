@@ -8,14 +8,16 @@
 #include <thrust/iterator/counting_iterator.h>
 
 #include <algorithm>
+#include <chrono>
 
 #include "trace_bvh2.h"
 #include "traverse_bvh2.h"
 
-namespace kmbvh::detail {
+namespace kmbvh {
 namespace {
 
 constexpr uint32_t kLocalStack = 64;
+constexpr size_t kScratchBytes = size_t(256) << 20;
 
 struct TraceLocalStack {
   Bvh2View view;
@@ -41,33 +43,59 @@ struct TraceScratchStack {
 };
 
 template <typename T>
-const T* raw(const thrust::device_vector<T>& v) {
+T* raw(thrust::device_vector<T>& v) {
   return thrust::raw_pointer_cast(v.data());
+}
+
+template <typename F>
+void for_each_ray(size_t n, const F& f) {
+  thrust::for_each(thrust::device, thrust::counting_iterator<uint32_t>(0),
+                   thrust::counting_iterator<uint32_t>(uint32_t(n)), f);
 }
 
 }  // namespace
 
-void trace_bvh2_gpu(const Bvh2& bvh, const Ray* rays, size_t n, Query query, Hit* hits) {
-  const thrust::device_vector<Bvh2Node> nodes(bvh.nodes.begin(), bvh.nodes.end());
-  const thrust::device_vector<LeafTriangle> triangles(bvh.triangles.begin(), bvh.triangles.end());
-  const thrust::device_vector<PrimitiveId> ids(bvh.ids.begin(), bvh.ids.end());
-  const thrust::device_vector<Ray> d_rays(rays, rays + n);
-  thrust::device_vector<Hit> d_hits(n);
-  const Bvh2View view{raw(nodes), raw(triangles), raw(ids), uint32_t(bvh.nodes.size()), bvh.stack_size};
-  Hit* out = thrust::raw_pointer_cast(d_hits.data());
-  if (view.stack_size <= kLocalStack) {
-    thrust::for_each(thrust::device, thrust::counting_iterator<uint32_t>(0), thrust::counting_iterator<uint32_t>(uint32_t(n)),
-                     TraceLocalStack{view, raw(d_rays), out, query});
-  } else {
-    const size_t batch = std::max<size_t>(1, (size_t(256) << 20) / (sizeof(TraversalEntry) * view.stack_size));
-    thrust::device_vector<TraversalEntry> scratch(std::min(batch, n) * view.stack_size);
-    for (size_t first = 0; first < n; first += batch) {
-      const uint32_t count = uint32_t(std::min(batch, n - first));
-      thrust::for_each(thrust::device, thrust::counting_iterator<uint32_t>(0), thrust::counting_iterator<uint32_t>(count),
-                       TraceScratchStack{view, raw(d_rays), out, query, thrust::raw_pointer_cast(scratch.data()), first});
-    }
-  }
-  thrust::copy(d_hits.begin(), d_hits.end(), hits);
+struct Bvh2OnGpu::Impl {
+  thrust::device_vector<Bvh2Node> nodes;
+  thrust::device_vector<LeafTriangle> triangles;
+  thrust::device_vector<PrimitiveId> ids;
+  Bvh2View view;
+  thrust::device_vector<Ray> rays;  // grown to the largest batch seen, never shrunk
+  thrust::device_vector<Hit> hits;
+  thrust::device_vector<TraversalEntry> scratch;
+};
+
+Bvh2OnGpu::Bvh2OnGpu(const Bvh2& bvh) : impl_(std::make_unique<Impl>()) {
+  require_backend(Backend::Cuda);
+  Impl& g = *impl_;
+  g.nodes.assign(bvh.nodes.begin(), bvh.nodes.end());
+  g.triangles.assign(bvh.triangles.begin(), bvh.triangles.end());
+  g.ids.assign(bvh.ids.begin(), bvh.ids.end());
+  g.view = Bvh2View{raw(g.nodes), raw(g.triangles), raw(g.ids), uint32_t(bvh.nodes.size()), bvh.stack_size};
 }
 
-}  // namespace kmbvh::detail
+Bvh2OnGpu::~Bvh2OnGpu() = default;
+
+void Bvh2OnGpu::trace(const Ray* rays, size_t n, Query query, Hit* hits) {
+  if (n == 0) return;
+  Impl& g = *impl_;
+  if (g.rays.size() < n) {
+    g.rays.resize(n);
+    g.hits.resize(n);
+  }
+  thrust::copy(rays, rays + n, g.rays.begin());
+  const auto start = std::chrono::steady_clock::now();  // Thrust's for_each returns when the kernel is done
+  if (g.view.stack_size <= kLocalStack) {
+    for_each_ray(n, TraceLocalStack{g.view, raw(g.rays), raw(g.hits), query});
+  } else {
+    const size_t batch = std::max<size_t>(1, kScratchBytes / (sizeof(TraversalEntry) * g.view.stack_size));
+    if (g.scratch.size() < std::min(batch, n) * g.view.stack_size) g.scratch.resize(std::min(batch, n) * g.view.stack_size);
+    for (size_t first = 0; first < n; first += batch)
+      for_each_ray(std::min(batch, n - first),
+                   TraceScratchStack{g.view, raw(g.rays), raw(g.hits), query, raw(g.scratch), first});
+  }
+  last_kernel_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+  thrust::copy(g.hits.begin(), g.hits.begin() + n, hits);
+}
+
+}  // namespace kmbvh

@@ -63,9 +63,16 @@ struct KindResult {
   RayKind kind = RayKind::Primary;
   size_t rays = 0;
   double mrays = 0;
+  double kernel_mrays = 0;  // GPU: the kernel alone, transfers excluded
   const EmbreeResult* embree = nullptr;
   HitComparison comparison;
 };
+
+void print_kernel_rate(const KindResult& r) {
+  if (r.kernel_mrays > 0)
+    fmt::print("  {} on the GPU: {:.2f} Mrays/s in the kernel alone, without the rays' and hits' transfers\n",
+               to_string(r.kind), r.kernel_mrays);
+}
 
 Json ray_json(const Ray& r) {
   return Json{{"org", {r.org.x, r.org.y, r.org.z}}, {"dir", {r.dir.x, r.dir.y, r.dir.z}}, {"tnear", r.tnear}, {"tfar", r.tfar}};
@@ -169,7 +176,12 @@ int run_trace(const TraceCommand& c) {
       r.kind = kind;
       r.rays = rays.of(kind).size();
       std::vector<Hit> hits;
-      r.mrays = mrays(r.rays, median_seconds(c.run.runs, c.run.warmup, [&] { tracer.trace(rays.of(kind), query_for(kind), hits); }));
+      std::vector<double> kernel_ms;
+      r.mrays = mrays(r.rays, median_seconds(c.run.runs, c.run.warmup, [&] {
+                        tracer.trace(rays.of(kind), query_for(kind), hits);
+                        kernel_ms.push_back(tracer.last_kernel_ms());
+                      }));
+      r.kernel_mrays = mrays(r.rays, median(kernel_ms) * 1e-3);
       if (embree) {
         r.embree = &embree_results[int(kind)];
         r.comparison = compare_hits(scene.geometry, rays.of(kind), query_for(kind), hits, r.embree->hits, c.show);
@@ -182,6 +194,7 @@ int run_trace(const TraceCommand& c) {
       Json kinds_json = Json::array();
       for (const KindResult& r : results) {
         Json k{{"kind", to_string(r.kind)}, {"rays", r.rays}, {"kmbvh_mrays_per_s", r.mrays}};
+        if (r.kernel_mrays > 0) k["kmbvh_kernel_mrays_per_s"] = r.kernel_mrays;
         if (r.embree) {
           k["embree_mrays_per_s"] = r.embree->single_mrays;
           k["embree16_mrays_per_s"] = r.embree->packet_mrays;
@@ -205,11 +218,13 @@ int run_trace(const TraceCommand& c) {
     for (const KindResult& r : results) {
       if (!r.embree) {
         fmt::print("{:<8} {:>8} {:>13.2f}\n", to_string(r.kind), r.rays, r.mrays);
+        print_kernel_rate(r);
         continue;
       }
       fmt::print("{:<8} {:>8} {:>13.2f} {:>13.2f} {:>7.2f} {:>13.2f} {:>10} {:>9}\n", to_string(r.kind), r.rays, r.mrays,
                  r.embree->single_mrays, r.embree->single_mrays > 0 ? r.mrays / r.embree->single_mrays : 0.0,
                  r.embree->packet_mrays, r.comparison.mismatches(), r.comparison.edge_ties);
+      print_kernel_rate(r);
       const HitComparison& m = r.comparison;
       if (m.mismatches())
         fmt::print("  {} {} mismatches: hit/miss {}, distance {}, primitive {}, normal {}, barycentrics {}\n",
