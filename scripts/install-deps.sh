@@ -10,6 +10,7 @@ packages=(
   libthrust-dev
   libcli11-dev libfmt-dev libspdlog-dev
   libgtest-dev
+  embree-tools openimageio-tools
 )
 
 missing=()

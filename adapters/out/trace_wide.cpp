@@ -110,7 +110,9 @@ struct PackRay {
 // same operations as the scalar test. Returns the slot of the nearest hit in (tnear,
 // tmax] and its t, or -1. A slot whose edge functions come out exactly zero goes to the
 // scalar test, which redoes them in double precision.
-inline int intersect_pack(const TrianglePack& p, const PackRay& r, float tnear, float tmax, float& t_hit) {
+// `skip`: slots a hit filter has already turned down for this ray (0 without a filter).
+inline int intersect_pack(const TrianglePack& p, const PackRay& r, float tnear, float tmax, float& t_hit,
+                          unsigned skip = 0) {
   const RayShear& s = r.shear;
   vfp x[3], y[3], z[3];
   for (int v = 0; v < 3; ++v) {
@@ -132,8 +134,8 @@ inline int intersect_pack(const TrianglePack& p, const PackRay& r, float tnear, 
   const vip valid = ~(negative & positive) & (det != zero) & (abs_T > (vfp{} + tnear) * abs_det) &
                     (abs_T <= (vfp{} + tmax) * abs_det);
   const vip exact_zero = (U == zero) | (V == zero) | (W == zero);
-  unsigned hits = mask_bits(valid & ~exact_zero);
-  unsigned redo = mask_bits(exact_zero);
+  unsigned hits = mask_bits(valid & ~exact_zero) & ~skip;
+  unsigned redo = mask_bits(exact_zero) & ~skip;
   int best = -1;
   if (hits) {
     const vfp t = T / det;
@@ -169,8 +171,11 @@ bool finish_hit(const WideBvh<W>& bvh, const Ray& ray, uint32_t found, Hit& hit)
 }
 
 // The traversal, compiled once per query so the inner loop carries no test of it.
-template <int W, Query query>
-bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit) {
+// With a filter (Filtered), every candidate hit is offered to it before it counts, as
+// Embree offers hits to an application's filter functions; a refused one is skipped and
+// the traversal goes on.
+template <int W, Query query, bool Filtered = false>
+bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit, const HitFilter* filter = nullptr) {
   hit = Hit();
   if (bvh.nodes.empty() || !ray_can_hit(ray)) return false;
   const RayBoxSetup setup(ray);
@@ -222,16 +227,38 @@ bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit)
     }
     for (uint32_t p = cur.ref, end = cur.ref + (cur.count + kPackWidth - 1) / kPackWidth; p < end; ++p) {
       float t;
-      const int slot = intersect_pack(bvh.packs[p], pack_ray, ray.tnear, tmax, t);
-      if (slot < 0) continue;
-      found = p * kPackWidth + uint32_t(slot);
-      hit.t = t;
-      if (query == Query::Any) return finish_hit(bvh, ray, found, hit);
-      tmax = t;
+      if (!Filtered) {
+        const int slot = intersect_pack(bvh.packs[p], pack_ray, ray.tnear, tmax, t);
+        if (slot < 0) continue;
+        found = p * kPackWidth + uint32_t(slot);
+        hit.t = t;
+        if (query == Query::Any) return finish_hit(bvh, ray, found, hit);
+        tmax = t;
+        continue;
+      }
+      // The pack's nearest slot first; one the filter refuses is skipped and the next
+      // nearest tried.
+      for (unsigned skip = 0;;) {
+        const int slot = intersect_pack(bvh.packs[p], pack_ray, ray.tnear, tmax, t, skip);
+        if (slot < 0) break;
+        const uint32_t candidate = p * kPackWidth + uint32_t(slot);
+        Hit offered;
+        offered.t = t;
+        finish_hit(bvh, ray, candidate, offered);
+        if (!filter->accept(filter->user, ray, offered)) {
+          skip |= 1u << slot;
+          continue;
+        }
+        hit = offered;
+        if (query == Query::Any) return true;
+        found = candidate;
+        tmax = t;
+        break;  // the pack's other slots are farther
+      }
     }
   pop:
     do {
-      if (sp == 0) return finish_hit(bvh, ray, found, hit);
+      if (sp == 0) return Filtered ? found != kInvalidId : finish_hit(bvh, ray, found, hit);
       cur = stack[--sp];
     } while (cur.entry > tmax);
   }
@@ -242,6 +269,13 @@ bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit)
 template <int W>
 bool trace_wide_ray(const WideBvh<W>& bvh, const Ray& ray, Query query, WideEntry* stack, Hit& hit) {
   return query == Query::Any ? traverse<W, Query::Any>(bvh, ray, stack, hit) : traverse<W, Query::Closest>(bvh, ray, stack, hit);
+}
+
+template <int W>
+bool trace_wide_ray(const WideBvh<W>& bvh, const Ray& ray, Query query, WideEntry* stack, Hit& hit,
+                    const HitFilter& filter) {
+  return query == Query::Any ? traverse<W, Query::Any, true>(bvh, ray, stack, hit, &filter)
+                             : traverse<W, Query::Closest, true>(bvh, ray, stack, hit, &filter);
 }
 
 template <int W>
@@ -258,6 +292,8 @@ void trace_wide(const WideBvh<W>& bvh, const std::vector<Ray>& rays, Query query
 
 template bool trace_wide_ray<4>(const WideBvh<4>&, const Ray&, Query, WideEntry*, Hit&);
 template bool trace_wide_ray<8>(const WideBvh<8>&, const Ray&, Query, WideEntry*, Hit&);
+template bool trace_wide_ray<4>(const WideBvh<4>&, const Ray&, Query, WideEntry*, Hit&, const HitFilter&);
+template bool trace_wide_ray<8>(const WideBvh<8>&, const Ray&, Query, WideEntry*, Hit&, const HitFilter&);
 template void trace_wide<4>(const WideBvh<4>&, const std::vector<Ray>&, Query, std::vector<Hit>&);
 template void trace_wide<8>(const WideBvh<8>&, const std::vector<Ray>&, Query, std::vector<Hit>&);
 

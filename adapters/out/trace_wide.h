@@ -25,4 +25,18 @@ struct WideEntry {
 template <int W>
 bool trace_wide_ray(const WideBvh<W>& bvh, const Ray& ray, Query query, WideEntry* stack, Hit& hit);
 
+// Decides whether a candidate hit counts (Embree's filter functions): `offered` is complete
+// (t, u, v, Ng, ids); returning false skips it and the traversal goes on.
+struct HitFilter {
+  bool (*accept)(void* user, const Ray& ray, const Hit& offered);
+  void* user;
+};
+
+// The same with every candidate hit offered to `filter` first, in traversal order: for
+// Query::Any the first accepted hit ends the ray; for Query::Closest accepted hits shorten
+// the ray as they come, as in Embree.
+template <int W>
+bool trace_wide_ray(const WideBvh<W>& bvh, const Ray& ray, Query query, WideEntry* stack, Hit& hit,
+                    const HitFilter& filter);
+
 }  // namespace kmbvh

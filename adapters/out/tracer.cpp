@@ -5,6 +5,7 @@
 
 #include "bvh2_layout.h"
 #include "collapse_wide.h"
+#include "cuda/traversal/traverse_bvh2.h"
 #include "trace_wide.h"
 #include "wide_bvh.h"
 
@@ -34,7 +35,8 @@ Layout parse_layout(const std::string& name) {
 
 uint32_t layout_width(Layout layout) { return layout == Layout::Bvh2 ? 2 : layout == Layout::Bvh4 ? 4 : 8; }
 
-Tracer::Tracer(const Bvh& bvh, const PrimitiveSet& prims, const TriangleScene& scene, Layout layout, Backend backend)
+Tracer::Tracer(const Bvh& bvh, const PrimitiveSet& prims, const TriangleScene& scene, Layout layout, Backend backend,
+               const std::vector<PrimitiveId>* reported_ids)
     : layout_(layout), layouts_(std::make_unique<Layouts>()) {
   if (backend == Backend::Cuda && layout != Layout::Bvh2)
     throw std::invalid_argument("the CUDA traversal reads the bvh2 layout; bvh4 and bvh8 are CPU SIMD layouts");
@@ -48,6 +50,11 @@ Tracer::Tracer(const Bvh& bvh, const PrimitiveSet& prims, const TriangleScene& s
   collapsed_ = layout != Layout::Bvh2 && arity <= 2;
   tree_ = collapsed_ ? collapse_to_width(bvh, width) : bvh;
   LeafTriangles triangles = leaf_triangles(tree_, prims, scene);
+  if (reported_ids) {
+    if (reported_ids->size() != scene.triangles.size())
+      throw std::invalid_argument("Tracer: reported_ids needs one id per triangle of the scene");
+    for (PrimitiveId& id : triangles.ids) id = (*reported_ids)[id.prim];
+  }
   switch (layout) {
     case Layout::Bvh2:
       layouts_->bvh2 = make_bvh2(tree_, std::move(triangles));
@@ -71,6 +78,52 @@ void Tracer::trace(const std::vector<Ray>& rays, Query query, std::vector<Hit>& 
     case Layout::Bvh4: return trace_wide(layouts_->bvh4, rays, query, hits);
     case Layout::Bvh8: return trace_wide(layouts_->bvh8, rays, query, hits);
   }
+}
+
+namespace {
+
+// The traversal stack of trace_one: on the C++ stack up to this many entries (6 KiB),
+// which covers 8-wide trees 73 levels deep; a deeper tree gets a thread-local buffer.
+constexpr uint32_t kLocalStack = 512;
+
+template <typename Entry>
+Entry* deep_stack(uint32_t size) {
+  thread_local std::vector<Entry> stack;
+  if (stack.size() < size) stack.resize(size);
+  return stack.data();
+}
+
+template <int W>
+bool trace_one_wide(const WideBvh<W>& bvh, const Ray& ray, Query query, Hit& hit, const HitFilter* filter) {
+  WideEntry local[kLocalStack];
+  WideEntry* stack = bvh.stack_size <= kLocalStack ? local : deep_stack<WideEntry>(bvh.stack_size);
+  return filter ? trace_wide_ray(bvh, ray, query, stack, hit, *filter) : trace_wide_ray(bvh, ray, query, stack, hit);
+}
+
+}  // namespace
+
+bool Tracer::trace_one(const Ray& ray, Query query, Hit& hit) const {
+  switch (layout_) {
+    case Layout::Bvh2: {
+      const Bvh2& b = layouts_->bvh2;
+      TraversalEntry local[kLocalStack];
+      TraversalEntry* stack = b.stack_size <= kLocalStack ? local : deep_stack<TraversalEntry>(b.stack_size);
+      return kmbvh::trace_bvh2(b.view(), ray, query, stack, hit);
+    }
+    case Layout::Bvh4: return trace_one_wide(layouts_->bvh4, ray, query, hit, nullptr);
+    case Layout::Bvh8: return trace_one_wide(layouts_->bvh8, ray, query, hit, nullptr);
+  }
+  hit = Hit();
+  return false;
+}
+
+bool Tracer::trace_one(const Ray& ray, Query query, Hit& hit, const HitFilter& filter) const {
+  switch (layout_) {
+    case Layout::Bvh2: break;
+    case Layout::Bvh4: return trace_one_wide(layouts_->bvh4, ray, query, hit, &filter);
+    case Layout::Bvh8: return trace_one_wide(layouts_->bvh8, ray, query, hit, &filter);
+  }
+  throw std::logic_error("Tracer::trace_one: hit filters need a bvh4 or bvh8 layout");
 }
 
 double Tracer::last_kernel_ms() const { return layouts_->bvh2_gpu ? layouts_->bvh2_gpu->last_kernel_ms() : 0.0; }

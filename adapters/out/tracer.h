@@ -9,6 +9,7 @@
 #include <vector>
 
 #include "adapters/in/triangle_scene.h"
+#include "adapters/out/trace_wide.h"
 #include "cuda/core/backend.h"
 #include "cuda/core/bvh.h"
 #include "cuda/traversal/ray.h"
@@ -26,12 +27,23 @@ class Tracer {
   // prims: the set `bvh` was built over, made from `scene`. A binary tree is collapsed for
   // the wide layouts; a k-ary tree (k-means --wide) is laid out as built, so its arity must
   // not exceed the layout's width. Throws std::invalid_argument when it cannot be laid out.
+  // reported_ids, when given, is what a hit reports for each triangle of `scene` (indexed
+  // by the triangle's position, as prims' ids are): Embree's geomID/primID pairs of a
+  // scene flattened from several meshes.
   Tracer(const Bvh& bvh, const PrimitiveSet& prims, const TriangleScene& scene, Layout layout,
-         Backend backend = Backend::Cpu);
+         Backend backend = Backend::Cpu, const std::vector<PrimitiveId>* reported_ids = nullptr);
   ~Tracer();
   Tracer(Tracer&&) noexcept;
 
   void trace(const std::vector<Ray>& rays, Query query, std::vector<Hit>& hits) const;
+
+  // One ray on the calling thread, on the CPU whatever the backend: no OpenMP, no
+  // allocation (beyond one thread-local stack for trees deeper than any seen in practice),
+  // safe to call from many threads at once. For per-ray entry points (rtcIntersect1).
+  bool trace_one(const Ray& ray, Query query, Hit& hit) const;
+  // The same with every candidate hit offered to `filter` first (trace_wide.h); a wide
+  // layout only (throws std::logic_error for bvh2).
+  bool trace_one(const Ray& ray, Query query, Hit& hit, const HitFilter& filter) const;
 
   Layout layout() const { return layout_; }
   const Bvh& traced_tree() const { return tree_; }  // the tree as laid out (after any collapse)

@@ -1,0 +1,31 @@
+#include "build_primitives.h"
+
+#include <fmt/format.h>
+
+#include <cmath>
+#include <stdexcept>
+
+namespace kmbvh {
+
+PrimitiveSet primitive_set_from(const RTCBuildPrimitive* primitives, size_t count) {
+  PrimitiveSet set;
+  set.boxes.resize(count);
+  set.ids.resize(count);
+  for (size_t i = 0; i < count; ++i) {
+    const RTCBuildPrimitive& p = primitives[i];
+    const Vec3 lo(p.lower_x, p.lower_y, p.lower_z), hi(p.upper_x, p.upper_y, p.upper_z);
+    for (int a = 0; a < 3; ++a) {
+      if (!std::isfinite(lo[a]) || !std::isfinite(hi[a]))
+        throw std::invalid_argument(fmt::format("primitive {} (geomID {}, primID {}) has a non-finite bound", i,
+                                                p.geomID, p.primID));
+      if (lo[a] > hi[a])
+        throw std::invalid_argument(fmt::format("primitive {} (geomID {}, primID {}) has lower > upper on axis {}", i,
+                                                p.geomID, p.primID, "xyz"[a]));
+    }
+    set.boxes[i] = Aabb{lo, hi};
+    set.ids[i] = PrimitiveId{p.geomID, p.primID};
+  }
+  return set;
+}
+
+}  // namespace kmbvh

@@ -1,0 +1,306 @@
+#include "embree_callbacks.h"
+
+#include <omp.h>
+
+#include <algorithm>
+#include <atomic>
+#include <exception>
+#include <mutex>
+
+namespace kmbvh {
+namespace {
+
+constexpr uint32_t kMaxBranching = 16;       // the widest node Embree 3 makes
+constexpr uint32_t kTaskPrimitives = 4096;   // subtrees this large are emitted as tasks of their own
+
+RTCBounds to_bounds(const Aabb& b) {
+  RTCBounds r;
+  r.lower_x = b.lo.x, r.lower_y = b.lo.y, r.lower_z = b.lo.z, r.align0 = 0;
+  r.upper_x = b.hi.x, r.upper_y = b.hi.y, r.upper_z = b.hi.z, r.align1 = 0;
+  return r;
+}
+
+Aabb box_of(const RTCBuildPrimitive& p) {
+  return Aabb{Vec3(p.lower_x, p.lower_y, p.lower_z), Vec3(p.upper_x, p.upper_y, p.upper_z)};
+}
+
+Aabb box_of(const RTCBuildPrimitive* p, size_t n) {
+  Aabb b;
+  for (size_t i = 0; i < n; ++i) b.grow(box_of(p[i]));
+  return b;
+}
+
+class Emitter {
+ public:
+  Emitter(const Bvh& bvh, RTCBuildPrimitive* out, const EmitLimits& limits, const EmbreeCallbacks& callbacks,
+          const std::vector<RTCThreadLocalAllocator>& allocators)
+      : bvh_(bvh), out_(out), limits_(limits), callbacks_(callbacks), allocators_(allocators) {}
+
+  EmitResult run(const PrimitiveSet& prims) {
+    plan();
+    reorder(prims.size());
+    void* root = nullptr;
+#pragma omp parallel
+#pragma omp single
+    root = node_or_fail(0, 1);
+    if (error_) std::rethrow_exception(error_);
+    result_.root = root;
+    const double root_area = bvh_.root().box.surface_area();
+    result_.sah_cost = root_area > 0 ? cost_sum_ / root_area : 0.0;
+    result_.depth = depth_.load();
+    result_.inner_nodes = inner_.load();
+    result_.leaves = leaves_.load();
+    result_.rebalanced = rebalanced_.load();
+    return result_;
+  }
+
+ private:
+  // Levels a balanced tree of n primitives needs (binary median splits).
+  uint32_t balanced_height(size_t n) const {
+    uint32_t h = 1;
+    for (; n > limits_.max_leaf; n = (n + 1) / 2) ++h;
+    return h;
+  }
+
+  // Bottom-up (children are stored after their parents): counts, SAH costs with the
+  // application's constants, which subtrees become leaves, and heights after that.
+  void plan() {
+    // The plan prices binary nodes, but widening to b children removes about b - 2 of every
+    // b - 1 of them: each binary node pays a (b - 1)-th of a wide node's traversal cost.
+    // Without that, leaves come out larger than Embree's for the same constants.
+    binary_traversal_cost_ = double(limits_.traversal_cost) / double(limits_.branching - 1);
+    const size_t n = bvh_.nodes.size();
+    count_.assign(n, 0);
+    height_.assign(n, 1);
+    as_leaf_.assign(n, 0);
+    cost_.assign(n, 0.0);
+    for (size_t v = n; v-- > 0;) {
+      const BvhNode& node = bvh_.nodes[v];
+      const double leaf_cost_per_prim = double(limits_.intersection_cost) * node.box.surface_area();
+      if (node.is_leaf()) {
+        count_[v] = node.count;
+        as_leaf_[v] = 1;
+        cost_[v] = leaf_cost_per_prim * node.count;
+        height_[v] = balanced_height(node.count);
+        continue;
+      }
+      uint32_t count = 0, height = 0;
+      double inner_cost = binary_traversal_cost_ * node.box.surface_area();
+      for (uint32_t c = node.first; c < node.first + node.count; ++c) {
+        count += count_[c];
+        height = std::max(height, height_[c]);
+        inner_cost += cost_[c];
+      }
+      count_[v] = count;
+      const bool fits = count <= limits_.max_leaf;
+      if (fits && (count <= limits_.min_leaf || leaf_cost_per_prim * count <= inner_cost)) {
+        as_leaf_[v] = 1;
+        cost_[v] = leaf_cost_per_prim * count;
+        height_[v] = 1;
+      } else {
+        cost_[v] = inner_cost;
+        height_[v] = height + 1;
+      }
+    }
+  }
+
+  // Top-down: each subtree's range of the primitive array, and the primitives written
+  // there in leaf order (the array is the application's; Embree reorders it too).
+  void reorder(size_t n) {
+    first_.assign(bvh_.nodes.size(), 0);
+    const std::vector<RTCBuildPrimitive> original(out_, out_ + n);
+    for (size_t v = 0; v < bvh_.nodes.size(); ++v) {
+      const BvhNode& node = bvh_.nodes[v];
+      if (node.is_leaf()) {
+        for (uint32_t j = 0; j < node.count; ++j) out_[first_[v] + j] = original[bvh_.prim_indices[node.first + j]];
+        continue;
+      }
+      uint32_t at = first_[v];
+      for (uint32_t c = node.first; c < node.first + node.count; ++c) {
+        first_[c] = at;
+        at += count_[c];
+      }
+    }
+  }
+
+  RTCThreadLocalAllocator allocator() const { return allocators_[size_t(omp_get_thread_num())]; }
+
+  void note_depth(uint32_t depth) {
+    uint32_t seen = depth_.load(std::memory_order_relaxed);
+    while (depth > seen && !depth_.compare_exchange_weak(seen, depth, std::memory_order_relaxed)) {
+    }
+  }
+
+  void add_cost(double c) {
+#pragma omp atomic
+    cost_sum_ += c;
+  }
+
+  void fail(std::exception_ptr e) {
+    std::lock_guard<std::mutex> lock(error_mutex_);
+    if (!error_) error_ = e;
+    failed_ = true;
+  }
+
+  // Exceptions must not leave an OpenMP task: the first is kept and rethrown by run().
+  void* node_or_fail(uint32_t v, uint32_t depth) {
+    try {
+      return emit_node(v, depth);
+    } catch (...) {
+      fail(std::current_exception());
+      return nullptr;
+    }
+  }
+  void* range_or_fail(size_t first, size_t count, uint32_t depth) {
+    try {
+      return emit_range(first, count, depth);
+    } catch (...) {
+      fail(std::current_exception());
+      return nullptr;
+    }
+  }
+
+  void* emit_leaf(size_t first, size_t count, uint32_t depth) {
+    if (depth > limits_.max_depth) throw DepthLimitError("depth limit reached");
+    note_depth(depth);
+    ++leaves_;
+    add_cost(double(limits_.intersection_cost) * double(count) * box_of(out_ + first, count).surface_area());
+    return callbacks_.create_leaf(allocator(), out_ + first, count, callbacks_.user);
+  }
+
+  // createNode, then setNodeBounds, then the children, then setNodeChildren: Embree's order.
+  template <typename EmitChild>
+  void* emit_inner(const Aabb& box, const Aabb* boxes, const uint32_t* counts, uint32_t n, uint32_t depth,
+                   const EmitChild& emit_child) {
+    if (depth >= limits_.max_depth) throw DepthLimitError("depth limit reached");
+    note_depth(depth);
+    ++inner_;
+    add_cost(double(limits_.traversal_cost) * box.surface_area());
+    void* node = callbacks_.create_node(allocator(), n, callbacks_.user);
+    RTCBounds bounds[kMaxBranching];
+    const RTCBounds* bound_ptrs[kMaxBranching];
+    for (uint32_t i = 0; i < n; ++i) {
+      bounds[i] = to_bounds(boxes[i]);
+      bound_ptrs[i] = &bounds[i];
+    }
+    callbacks_.set_bounds(node, bound_ptrs, n, callbacks_.user);
+    void* children[kMaxBranching] = {};
+    for (uint32_t i = 0; i < n; ++i) {
+      if (i + 1 < n && counts[i] >= kTaskPrimitives) {
+#pragma omp task default(shared) firstprivate(i)
+        children[i] = emit_child(i);
+      } else {
+        children[i] = emit_child(i);
+      }
+    }
+#pragma omp taskwait
+    if (failed_) return nullptr;
+    callbacks_.set_children(node, children, n, callbacks_.user);
+    return node;
+  }
+
+  void* emit_node(uint32_t v, uint32_t depth) {
+    const BvhNode& node = bvh_.nodes[v];
+    const uint32_t count = count_[v];
+    if (as_leaf_[v] && count <= limits_.max_leaf) return emit_leaf(first_[v], count, depth);
+    const bool fits = depth + height_[v] - 1 <= limits_.max_depth;
+    if (!fits && (node.is_leaf() || depth + balanced_height(count) - 1 <= limits_.max_depth)) {
+      ++rebalanced_;
+      return emit_range(first_[v], count, depth);
+    }
+    if (node.is_leaf()) return emit_range(first_[v], count, depth);  // a leaf larger than max_leaf
+
+    if (node.count > limits_.branching)
+      throw std::logic_error("emit_to_callbacks: a node has more children than the branching factor");
+    // Children, widened: the inner child of largest area is replaced by its own children
+    // while they fit in the branching factor.
+    uint32_t kids[kMaxBranching];
+    uint32_t n = 0;
+    for (uint32_t c = node.first; c < node.first + node.count; ++c) kids[n++] = c;
+    for (;;) {
+      int best = -1;
+      float best_area = -1.0f;
+      for (uint32_t i = 0; i < n; ++i) {
+        const BvhNode& k = bvh_.nodes[kids[i]];
+        if (as_leaf_[kids[i]] || k.is_leaf() || n - 1 + k.count > limits_.branching) continue;
+        if (k.box.surface_area() > best_area) best = int(i), best_area = k.box.surface_area();
+      }
+      if (best < 0) break;
+      const BvhNode& k = bvh_.nodes[kids[best]];
+      kids[best] = kids[n - 1];
+      --n;
+      for (uint32_t c = k.first; c < k.first + k.count; ++c) kids[n++] = c;
+    }
+    Aabb boxes[kMaxBranching];
+    uint32_t counts[kMaxBranching];
+    for (uint32_t i = 0; i < n; ++i) {
+      boxes[i] = bvh_.nodes[kids[i]].box;
+      counts[i] = count_[kids[i]];
+    }
+    return emit_inner(node.box, boxes, counts, n, depth, [&](uint32_t i) { return node_or_fail(kids[i], depth + 1); });
+  }
+
+  // A balanced subtree over out_[first, first + count): object-median splits along the
+  // widest axis of the centroids.
+  void* emit_range(size_t first, size_t count, uint32_t depth) {
+    if (count <= limits_.max_leaf) return emit_leaf(first, count, depth);
+    RTCBuildPrimitive* p = out_ + first;
+    Aabb centroids, box;
+    for (size_t i = 0; i < count; ++i) {
+      const Aabb b = box_of(p[i]);
+      box.grow(b);
+      centroids.grow(b.center());
+    }
+    const Vec3 e = centroids.extent();
+    const int axis = e.x >= e.y && e.x >= e.z ? 0 : (e.y >= e.z ? 1 : 2);
+    const size_t half = count / 2;
+    std::nth_element(p, p + half, p + count, [axis](const RTCBuildPrimitive& a, const RTCBuildPrimitive& b) {
+      return box_of(a).center()[axis] < box_of(b).center()[axis];
+    });
+    const Aabb boxes[2] = {box_of(p, half), box_of(p + half, count - half)};
+    const uint32_t counts[2] = {uint32_t(half), uint32_t(count - half)};
+    const size_t starts[2] = {first, first + half};
+    return emit_inner(box, boxes, counts, 2, depth,
+                      [&](uint32_t i) { return range_or_fail(starts[i], counts[i], depth + 1); });
+  }
+
+  const Bvh& bvh_;
+  RTCBuildPrimitive* out_;
+  const EmitLimits& limits_;
+  const EmbreeCallbacks& callbacks_;
+  const std::vector<RTCThreadLocalAllocator>& allocators_;
+
+  std::vector<uint32_t> count_, first_, height_;
+  std::vector<double> cost_;
+  std::vector<uint8_t> as_leaf_;
+
+  EmitResult result_;
+  double binary_traversal_cost_ = 0;
+  double cost_sum_ = 0;
+  std::atomic<uint32_t> depth_{0};
+  std::atomic<size_t> inner_{0}, leaves_{0}, rebalanced_{0};
+  std::mutex error_mutex_;
+  std::exception_ptr error_;  // the first failure, under error_mutex_
+  std::atomic<bool> failed_{false};
+};
+
+}  // namespace
+
+EmitResult emit_to_callbacks(const Bvh& bvh, const PrimitiveSet& prims, RTCBuildPrimitive* primitives,
+                             const EmitLimits& limits, const EmbreeCallbacks& callbacks,
+                             const std::vector<RTCThreadLocalAllocator>& allocators) {
+  if (prims.empty() || bvh.empty()) {
+    // Embree's answer for no primitives: one empty leaf.
+    EmitResult r;
+    r.root = callbacks.create_leaf(allocators.at(0), primitives, 0, callbacks.user);
+    r.leaves = 1;
+    r.depth = 1;
+    return r;
+  }
+  EmitLimits clamped = limits;
+  clamped.branching = std::clamp<uint32_t>(limits.branching, 2, kMaxBranching);
+  clamped.max_leaf = std::max<uint32_t>(limits.max_leaf, 1);
+  return Emitter(bvh, primitives, clamped, callbacks, allocators).run(prims);
+}
+
+}  // namespace kmbvh

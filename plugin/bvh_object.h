@@ -1,0 +1,71 @@
+// What kmbvhNewBVH returns behind the opaque RTCBVH: the memory that the application's
+// callbacks allocate for one tree through kmbvhThreadLocalAlloc, reference-counted as
+// Embree's BVH object is. Each build thread allocates from its own arena (no lock on the
+// common path); a new build frees the previous tree's memory, as Embree's does.
+#pragma once
+
+#include <embree3/rtcore.h>
+
+#include <atomic>
+#include <cstddef>
+#include <memory>
+#include <mutex>
+#include <utility>
+#include <vector>
+
+namespace kmbvh::plugin {
+
+class BvhObject;
+
+// The RTCThreadLocalAllocator handed to createNode/createLeaf: one per build thread.
+class Arena {
+ public:
+  explicit Arena(BvhObject* owner) : owner_(owner) {}
+  // Throws std::bad_alloc for sizes no machine has.
+  void* allocate(size_t bytes, size_t align);
+  RTCDevice device() const;
+
+ private:
+  BvhObject* owner_;
+  char* cursor_ = nullptr;
+  size_t left_ = 0;
+};
+
+class BvhObject {
+ public:
+  explicit BvhObject(RTCDevice device);
+  ~BvhObject();
+  BvhObject(const BvhObject&) = delete;
+  BvhObject& operator=(const BvhObject&) = delete;
+
+  static BvhObject* from(RTCBVH handle);  // null for null; the tag is checked
+  RTCBVH handle() { return reinterpret_cast<RTCBVH>(this); }
+
+  RTCDevice device() const { return device_; }
+  void retain() { refs_.fetch_add(1, std::memory_order_relaxed); }
+  bool release() { return refs_.fetch_sub(1, std::memory_order_acq_rel) == 1; }  // true: last
+
+  // Frees the last build's memory and makes `threads` arenas for the next one, with blocks
+  // sized from the primitive count (Embree sizes its allocator the same way).
+  void start_build(size_t threads, size_t primitives);
+  RTCThreadLocalAllocator allocator(size_t thread) {
+    return reinterpret_cast<RTCThreadLocalAllocator>(arenas_[thread].get());
+  }
+
+  // A block of at least `at_least` bytes and its size, owned by this object until the next
+  // build or the end.
+  std::pair<char*, size_t> new_block(size_t at_least);
+  size_t block_bytes() const { return block_bytes_; }
+
+ private:
+  static constexpr unsigned kTag = 0x6b6d6268;  // "kmbh": tells kmbvh's objects from others
+  unsigned tag_ = kTag;
+  std::atomic<int> refs_{1};
+  RTCDevice device_;
+  size_t block_bytes_ = 64 << 10;
+  std::mutex blocks_mutex_;
+  std::vector<std::unique_ptr<char[]>> blocks_;
+  std::vector<std::unique_ptr<Arena>> arenas_;
+};
+
+}  // namespace kmbvh::plugin

@@ -1,0 +1,95 @@
+#include "plugin_config.h"
+
+#include <fmt/format.h>
+
+#include <cstdio>
+#include <cstdlib>
+#include <stdexcept>
+
+namespace kmbvh::plugin {
+namespace {
+
+std::string env(const char* name) {
+  const char* v = std::getenv(name);
+  return v ? v : "";
+}
+
+uint32_t env_count(const char* name, uint32_t lo, uint32_t hi) {
+  const std::string v = env(name);
+  if (v.empty()) return 0;
+  char* end = nullptr;
+  const unsigned long x = std::strtoul(v.c_str(), &end, 10);
+  if (*end != '\0' || x < lo || x > hi)
+    throw std::invalid_argument(fmt::format("{}={}: expected a whole number from {} to {}", name, v, lo, hi));
+  return uint32_t(x);
+}
+
+}  // namespace
+
+PluginConfig read_plugin_config() {
+  PluginConfig c;
+  const std::string builder = env("KMBVH_BUILDER");
+  if (builder == "embree") {
+    c.pass_through = true;
+  } else if (!builder.empty()) {
+    if (builder.rfind("embree-", 0) == 0)
+      throw std::invalid_argument("KMBVH_BUILDER=" + builder + ": Embree's builders are reached with KMBVH_BUILDER=embree");
+    const BuilderConfig parsed = parse_builder(builder);  // throws for an unknown name
+    c.builder = parsed.builder;
+    if (parsed.builder == "kmeans" && builder != "kmeans") c.preset = parsed.preset;  // "Q4", "kmeans:Q4"
+  }
+  if (!env("KMBVH_PRESET").empty()) {
+    if (!kmeans_preset(env("KMBVH_PRESET")))
+      throw std::invalid_argument("KMBVH_PRESET=" + env("KMBVH_PRESET") + ": expected Q1, Q2, Q3, Q4 or Q5");
+    c.preset = env("KMBVH_PRESET");
+  }
+  c.k = env_count("KMBVH_K", 2, KMeansParams::kMaxK);
+  c.p = env_count("KMBVH_P", 1, 1024);
+  const std::string i = env("KMBVH_I");
+  if (!i.empty()) c.i = env_count("KMBVH_I", 0, 1000) + 1;  // stored +1: 0 iterations is valid
+  const std::string backend = env("KMBVH_BACKEND");
+  if (backend == "cuda")
+    c.backend = Backend::Cuda;
+  else if (!backend.empty() && backend != "cpu")
+    throw std::invalid_argument("KMBVH_BACKEND=" + backend + ": expected cpu or cuda");
+  c.log = !env("KMBVH_LOG").empty() && env("KMBVH_LOG") != "0";
+  return c;
+}
+
+const PluginConfig& plugin_config() {
+  static const PluginConfig config = [] {
+    try {
+      return read_plugin_config();
+    } catch (const std::exception& e) {
+      std::fprintf(stderr, "kmbvh: %s; using the defaults\n", e.what());
+      PluginConfig c;
+      c.log = !env("KMBVH_LOG").empty() && env("KMBVH_LOG") != "0";
+      return c;
+    }
+  }();
+  return config;
+}
+
+BuilderConfig builder_for(const PluginConfig& config, RTCBuildQuality quality) {
+  if (config.builder != "kmeans") {
+    BuilderConfig b = parse_builder(config.builder);
+    b.backend = config.backend;
+    return b;
+  }
+  std::string preset = config.preset;
+  if (preset.empty()) preset = quality == RTC_BUILD_QUALITY_LOW ? "Q1" : quality == RTC_BUILD_QUALITY_HIGH ? "Q5" : "Q3";
+  BuilderConfig b = parse_builder("kmeans:" + preset);
+  if (config.k || config.p || config.i) b.preset.clear();
+  if (config.k) b.kmeans.k = config.k;
+  if (config.p) b.kmeans.p = config.p;
+  if (config.i) b.kmeans.i = config.i - 1;
+  b.backend = config.backend;
+  return b;
+}
+
+void log_line(const std::string& line) {
+  const std::string text = "kmbvh: " + line + "\n";
+  std::fwrite(text.data(), 1, text.size(), stderr);
+}
+
+}  // namespace kmbvh::plugin

@@ -1,0 +1,41 @@
+// What the plug-in builds with, from the environment (read once per process):
+//   KMBVH_BUILDER  kmeans (default), any kmbvh builder (sweep-sah, lbvh, hlbvh, atrbvh,
+//                  ploc, Q1..Q5), or embree: every call passed to the real Embree
+//   KMBVH_PRESET   k-means preset Q1..Q5; default: chosen by the build quality
+//   KMBVH_K, KMBVH_P, KMBVH_I   k-means parameters, overriding the preset's
+//   KMBVH_LOG=1    one line per build (and per scene) on stderr
+//   KMBVH_BACKEND  cpu (default) or cuda
+#pragma once
+
+#include <embree3/rtcore.h>
+
+#include <string>
+
+#include "adapters/builder_registry.h"
+
+namespace kmbvh::plugin {
+
+struct PluginConfig {
+  bool pass_through = false;  // KMBVH_BUILDER=embree
+  std::string builder = "kmeans";
+  std::string preset;         // empty: by build quality
+  uint32_t k = 0, p = 0, i = 0;  // 0: the preset's
+  Backend backend = Backend::Cpu;
+  bool log = false;
+};
+
+// Throws std::invalid_argument naming the variable and its bad value.
+PluginConfig read_plugin_config();
+
+// The process's configuration; a bad environment is reported on stderr once and the
+// defaults are used.
+const PluginConfig& plugin_config();
+
+// The builder for one build of the given quality (LOW: Q1, MEDIUM: Q3, HIGH: Q5 for
+// k-means, unless KMBVH_PRESET/K/P/I say otherwise).
+BuilderConfig builder_for(const PluginConfig& config, RTCBuildQuality quality);
+
+// KMBVH_LOG lines go through here (stderr, one write per line).
+void log_line(const std::string& line);
+
+}  // namespace kmbvh::plugin

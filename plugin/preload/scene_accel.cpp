@@ -1,0 +1,81 @@
+#include "scene_accel.h"
+
+#include <chrono>
+
+#include "adapters/builder_registry.h"
+#include "cuda/metrics/sah.h"
+#include "plugin/plugin_config.h"
+#include "plugin/real_embree.h"
+
+namespace kmbvh::plugin {
+
+namespace {
+
+struct Offer {
+  const std::vector<GeometryFilters>* filters;
+  const RTCRay* app_ray;
+  RTCIntersectContext* context;
+  Query query;
+};
+
+}  // namespace
+
+bool SceneAccel::offer(void* user, const Ray&, const Hit& offered) {
+  const Offer& o = *static_cast<const Offer*>(user);
+  if (offered.geomID >= o.filters->size()) return true;
+  const GeometryFilters& f = (*o.filters)[offered.geomID];
+  const RTCFilterFunctionN filter = o.query == Query::Any ? f.occluded : f.intersect;
+  if (!filter) return true;
+  RTCRay ray = *o.app_ray;  // Embree shows the filter the ray ending at the hit
+  ray.tfar = offered.t;
+  RTCHit hit;
+  hit.Ng_x = offered.Ng.x, hit.Ng_y = offered.Ng.y, hit.Ng_z = offered.Ng.z;
+  hit.u = offered.u, hit.v = offered.v;
+  hit.primID = offered.primID, hit.geomID = offered.geomID;
+  hit.instID[0] = o.context ? o.context->instID[0] : RTC_INVALID_GEOMETRY_ID;
+  int valid = -1;
+  RTCFilterFunctionNArguments args;
+  args.valid = &valid;
+  args.geometryUserPtr = KMBVH_REAL_EMBREE(rtcGetGeometryUserData)(f.geometry);
+  args.context = o.context;
+  args.ray = reinterpret_cast<RTCRayN*>(&ray);  // RTCRayN and RTCHitN of width 1 are RTCRay, RTCHit
+  args.hit = reinterpret_cast<RTCHitN*>(&hit);
+  args.N = 1;
+  filter(&args);
+  return valid != 0;
+}
+
+bool SceneAccel::trace_filtered(const Ray& ray, const RTCRay& app_ray, unsigned ray_mask, Query query,
+                                RTCIntersectContext* context, Hit& hit) const {
+  if (ray_mask == 0 || !tracer_) return false;
+  Offer offer_data{&filters_, &app_ray, context, query};
+  return tracer_->trace_one(ray, query, hit, HitFilter{&SceneAccel::offer, &offer_data});
+}
+
+SceneAccel::SceneAccel(const std::vector<EmbreeTriangleMesh>& meshes, std::vector<GeometryFilters> filters,
+                       RTCBuildQuality quality, AccelReport& report)
+    : filters_(std::move(filters)) {
+  for (const GeometryFilters& f : filters_) {
+    intersect_filters_ |= f.intersect != nullptr;
+    occluded_filters_ |= f.occluded != nullptr;
+  }
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  FlattenedMeshes flat = flatten_triangle_meshes(meshes);
+  const BuilderConfig config = builder_for(plugin_config(), quality);
+  report.builder = config.label();
+  report.meshes = meshes.size();
+  report.dropped = flat.dropped;
+  report.triangles = flat.scene.triangles.size();
+  if (flat.scene.triangles.empty()) return;  // every ray misses
+  const PrimitiveSet prims = make_primitive_set(flat.scene);
+  const Bvh bvh = run_builder(config, prims);
+  report.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+  report.sah = sah_cost(bvh);
+  tracer_ = std::make_unique<Tracer>(bvh, prims, flat.scene, Layout::Bvh8, Backend::Cpu, &flat.ids);
+  report.layout_ms = tracer_->layout_ms();
+}
+
+SceneAccel::~SceneAccel() = default;
+
+}  // namespace kmbvh::plugin

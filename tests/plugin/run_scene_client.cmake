@@ -1,0 +1,42 @@
+# One scene-path test (cmake -P): scene_client traces on Embree alone, then under the
+# preload library with KMBVH_LOG set; the log must say who answered (EXPECT kmbvh: every
+# ray by kmbvh; EXPECT embree: a fallback, every ray by Embree), and the two runs'
+# answers must agree (scene_client compare).
+#   -DCLIENT=... -DPRELOAD=... -DSCENE=file|default -DWORK=dir -DEXPECT=kmbvh|embree
+#   [-DOPTIONS="--filter;--quad"] [-DSKIP_IF_MISSING=ON]
+if(SKIP_IF_MISSING AND NOT EXISTS "${SCENE}")
+  message("KMBVH-SKIPPED: scene ${SCENE} is absent (set KMBVH_SCENES_DIR)")
+  return()
+endif()
+file(MAKE_DIRECTORY "${WORK}")
+execute_process(COMMAND "${CLIENT}" trace "${SCENE}" "${WORK}/embree.bin" ${OPTIONS} RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "scene_client on Embree failed (${rc})")
+endif()
+execute_process(COMMAND ${CMAKE_COMMAND} -E env "LD_PRELOAD=${PRELOAD}" KMBVH_LOG=1
+                        "${CLIENT}" trace "${SCENE}" "${WORK}/kmbvh.bin" ${OPTIONS}
+                RESULT_VARIABLE rc ERROR_VARIABLE log)
+message("${log}")
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "scene_client under the preload library failed (${rc})")
+endif()
+if(NOT log MATCHES "scene path: ([0-9]+) rays answered by kmbvh, ([0-9]+) by Embree")
+  message(FATAL_ERROR "KMBVH_LOG has no ray counts")
+endif()
+set(by_kmbvh ${CMAKE_MATCH_1})
+set(by_embree ${CMAKE_MATCH_2})
+if(EXPECT STREQUAL "kmbvh")
+  if(by_kmbvh EQUAL 0 OR NOT by_embree EQUAL 0)
+    message(FATAL_ERROR "expected kmbvh to answer every ray: ${by_kmbvh} by kmbvh, ${by_embree} by Embree")
+  endif()
+  set(exact --exact-forms)
+else()
+  if(NOT by_kmbvh EQUAL 0 OR by_embree EQUAL 0 OR NOT log MATCHES "Embree answers it: ")
+    message(FATAL_ERROR "expected a logged fallback to Embree: ${by_kmbvh} by kmbvh, ${by_embree} by Embree")
+  endif()
+endif()
+execute_process(COMMAND "${CLIENT}" compare "${SCENE}" "${WORK}/embree.bin" "${WORK}/kmbvh.bin" ${OPTIONS} ${exact}
+                RESULT_VARIABLE rc)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "the answers differ")
+endif()

@@ -1,0 +1,139 @@
+// The scene path's pieces outside the preload library: Embree's buffers read with their
+// offset, stride and format (adapters/embree/embree_geometry.h), and the single-ray
+// traversal with and without a hit filter (Tracer::trace_one), which must give exactly
+// what the batch traversal gives.
+#include <gtest/gtest.h>
+
+#include <cmath>
+#include <cstring>
+#include <limits>
+
+#include "adapters/builder_registry.h"
+#include "adapters/embree/embree_geometry.h"
+#include "adapters/out/tracer.h"
+#include "support/scenes.h"
+
+namespace kmbvh {
+namespace {
+
+// Vertices 16 bytes apart, 4 bytes in; indices 16 bytes apart.
+struct PaddedVertex {
+  float pad, x, y, z;
+};
+struct PaddedTriangle {
+  uint32_t v[3], pad;
+};
+
+TEST(EmbreeGeometry, HonoursOffsetStrideAndDropsWhatEmbreeDrops) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  const PaddedVertex v[] = {{0, 0, 0, 0}, {0, 1, 0, 0}, {0, 0, 1, 0}, {0, nan, 0, 0}, {0, 2e18f, 0, 0}};
+  const PaddedTriangle t[] = {{{0, 1, 2}, 0}, {{0, 1, 5}, 0}, {{0, 3, 2}, 0}, {{4, 1, 2}, 0}, {{2, 1, 0}, 0}};
+  EmbreeTriangleMesh a{3, {reinterpret_cast<const char*>(v) + 4, RTC_FORMAT_FLOAT3, 16, 5},
+                       {t, RTC_FORMAT_UINT3, 16, 5}};
+  EmbreeTriangleMesh empty{7, {}, {}};
+  EmbreeTriangleMesh b = a;
+  b.geom_id = 9;
+  b.indices.count = 1;
+  const FlattenedMeshes f = flatten_triangle_meshes({a, empty, b});
+  ASSERT_EQ(f.scene.triangles.size(), 3u);  // out of range, NaN and 2e18 dropped
+  EXPECT_EQ(f.dropped, 3u);
+  ASSERT_EQ(f.ids.size(), 3u);
+  EXPECT_EQ(f.ids[0].geom, 3u);
+  EXPECT_EQ(f.ids[0].prim, 0u);
+  EXPECT_EQ(f.ids[1].geom, 3u);
+  EXPECT_EQ(f.ids[1].prim, 4u);
+  EXPECT_EQ(f.ids[2].geom, 9u);
+  EXPECT_EQ(f.ids[2].prim, 0u);
+  const Triangle& last = f.scene.triangles[1];
+  EXPECT_EQ(f.scene.positions[last[0]].y, 1.0f);  // vertex 2 of mesh a: (0, 1, 0)
+  EXPECT_EQ(f.scene.positions[last[1]].x, 1.0f);
+}
+
+TEST(EmbreeGeometry, RefusesFormatsItCannotRead) {
+  const float v[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
+  const uint32_t t[3] = {0, 1, 2};
+  EmbreeTriangleMesh m{0, {v, RTC_FORMAT_FLOAT3, 12, 3}, {t, RTC_FORMAT_UINT3, 12, 1}};
+  EXPECT_EQ(flatten_triangle_meshes({m}).scene.triangles.size(), 1u);
+  EmbreeTriangleMesh f4 = m;
+  f4.vertices.format = RTC_FORMAT_FLOAT4;
+  EXPECT_THROW(flatten_triangle_meshes({f4}), UnsupportedMesh);
+  EmbreeTriangleMesh short_stride = m;
+  short_stride.indices.byte_stride = 8;
+  EXPECT_THROW(flatten_triangle_meshes({short_stride}), UnsupportedMesh);
+  EmbreeTriangleMesh no_vertices = m;
+  no_vertices.vertices.data = nullptr;
+  EXPECT_THROW(flatten_triangle_meshes({no_vertices}), UnsupportedMesh);
+}
+
+std::vector<Ray> random_rays(const TriangleScene& scene, size_t n) {
+  const Aabb b = scene.bounds();
+  std::vector<Ray> rays(n);
+  for (size_t i = 0; i < n; ++i) {
+    const auto r = [&](uint32_t stream) { return test::random_unit(11, stream, uint32_t(i)); };
+    rays[i].org = Vec3(b.lo.x + r(0) * (b.hi.x - b.lo.x), b.lo.y + r(1) * (b.hi.y - b.lo.y), b.lo.z + r(2) * (b.hi.z - b.lo.z));
+    rays[i].dir = Vec3(r(3) - 0.5f, r(4) - 0.5f, r(5) - 0.5f);
+  }
+  return rays;
+}
+
+bool same(const Hit& a, const Hit& b) {
+  return a.found() == b.found() && (!a.found() || (a.t == b.t && a.u == b.u && a.v == b.v && a.primID == b.primID &&
+                                                   a.geomID == b.geomID && a.Ng.x == b.Ng.x && a.Ng.z == b.Ng.z));
+}
+
+TEST(TraceOne, SameAsTheBatchTraversalWithAndWithoutAFilter) {
+  const TriangleScene scene = test::random_triangles(3000, 5);
+  const PrimitiveSet prims = make_primitive_set(scene);
+  const Bvh bvh = run_builder(parse_builder("kmeans:Q3"), prims);
+  // Ids as a flattened Embree scene reports them: geomID 2, primID = index + 100.
+  std::vector<PrimitiveId> ids(scene.size());
+  for (size_t i = 0; i < ids.size(); ++i) ids[i] = PrimitiveId{2, uint32_t(i + 100)};
+  const Tracer tracer(bvh, prims, scene, Layout::Bvh8, Backend::Cpu, &ids);
+  const std::vector<Ray> rays = random_rays(scene, 4000);
+  const HitFilter accept_all{[](void*, const Ray&, const Hit&) { return true; }, nullptr};
+  const HitFilter refuse_odd{[](void*, const Ray&, const Hit& h) { return h.primID % 2 == 0; }, nullptr};
+
+  // The reference for the refusing filter: a tree over the even triangles only.
+  TriangleScene even;
+  even.positions = scene.positions;
+  std::vector<PrimitiveId> even_ids;
+  for (size_t i = 0; i < scene.size(); i += 2) even.triangles.push_back(scene.triangles[i]), even_ids.push_back(ids[i]);
+  const PrimitiveSet even_prims = make_primitive_set(even);
+  const Tracer even_tracer(run_builder(parse_builder("kmeans:Q3"), even_prims), even_prims, even, Layout::Bvh8,
+                           Backend::Cpu, &even_ids);
+  for (Query q : {Query::Closest, Query::Any}) {
+    std::vector<Hit> batch, even_batch;
+    tracer.trace(rays, q, batch);
+    even_tracer.trace(rays, q, even_batch);
+    size_t hits = 0;
+    for (size_t i = 0; i < rays.size(); ++i) {
+      Hit one, all, odd;
+      tracer.trace_one(rays[i], q, one);
+      tracer.trace_one(rays[i], q, all, accept_all);
+      tracer.trace_one(rays[i], q, odd, refuse_odd);
+      hits += one.found();
+      if (one.found()) {
+        EXPECT_EQ(one.geomID, 2u);
+      }
+      if (q == Query::Closest) {
+        EXPECT_TRUE(same(one, batch[i])) << "ray " << i;
+        EXPECT_TRUE(same(all, one)) << "ray " << i;
+        EXPECT_EQ(odd.found(), even_batch[i].found()) << "ray " << i;
+        if (odd.found() && even_batch[i].found()) {
+          EXPECT_EQ(odd.t, even_batch[i].t) << "ray " << i;
+        }
+        if (odd.found()) {
+          EXPECT_EQ(odd.primID % 2, 0u);
+        }
+      } else {
+        EXPECT_EQ(one.found(), batch[i].found()) << "ray " << i;
+        EXPECT_EQ(all.found(), one.found()) << "ray " << i;
+        EXPECT_EQ(odd.found(), even_batch[i].found()) << "ray " << i;
+      }
+    }
+    EXPECT_GT(hits, rays.size() / 4);
+  }
+}
+
+}  // namespace
+}  // namespace kmbvh
