@@ -46,11 +46,15 @@ class Emitter {
     if (error_) std::rethrow_exception(error_);
     result_.root = root;
     const double root_area = bvh_.root().box.surface_area();
-    result_.sah_cost = root_area > 0 ? cost_sum_ / root_area : 0.0;
-    result_.depth = depth_.load();
-    result_.inner_nodes = inner_.load();
-    result_.leaves = leaves_.load();
-    result_.rebalanced = rebalanced_.load();
+    double cost = 0;
+    for (const ThreadStats& t : stats_) {
+      cost += t.cost;
+      result_.depth = std::max(result_.depth, t.depth);
+      result_.inner_nodes += t.inner_nodes;
+      result_.leaves += t.leaves;
+      result_.rebalanced += t.rebalanced;
+    }
+    result_.sah_cost = root_area > 0 ? cost / root_area : 0.0;
     return result_;
   }
 
@@ -107,34 +111,35 @@ class Emitter {
   // Top-down: each subtree's range of the primitive array, and the primitives written
   // there in leaf order (the array is the application's; Embree reorders it too).
   void reorder(size_t n) {
-    first_.assign(bvh_.nodes.size(), 0);
-    const std::vector<RTCBuildPrimitive> original(out_, out_ + n);
-    for (size_t v = 0; v < bvh_.nodes.size(); ++v) {
+    const size_t nodes = bvh_.nodes.size();
+    first_.assign(nodes, 0);
+    for (size_t v = 0; v < nodes; ++v) {
       const BvhNode& node = bvh_.nodes[v];
-      if (node.is_leaf()) {
-        for (uint32_t j = 0; j < node.count; ++j) out_[first_[v] + j] = original[bvh_.prim_indices[node.first + j]];
-        continue;
-      }
+      if (node.is_leaf()) continue;
       uint32_t at = first_[v];
       for (uint32_t c = node.first; c < node.first + node.count; ++c) {
         first_[c] = at;
         at += count_[c];
       }
     }
+    const std::vector<RTCBuildPrimitive> original(out_, out_ + n);
+#pragma omp parallel for schedule(dynamic, 4096)
+    for (size_t v = 0; v < nodes; ++v) {
+      const BvhNode& node = bvh_.nodes[v];
+      if (!node.is_leaf()) continue;
+      for (uint32_t j = 0; j < node.count; ++j) out_[first_[v] + j] = original[bvh_.prim_indices[node.first + j]];
+    }
   }
 
   RTCThreadLocalAllocator allocator() const { return allocators_[size_t(omp_get_thread_num())]; }
 
-  void note_depth(uint32_t depth) {
-    uint32_t seen = depth_.load(std::memory_order_relaxed);
-    while (depth > seen && !depth_.compare_exchange_weak(seen, depth, std::memory_order_relaxed)) {
-    }
-  }
-
-  void add_cost(double c) {
-#pragma omp atomic
-    cost_sum_ += c;
-  }
+  // This thread's counters: shared ones would be contended on every node.
+  struct alignas(64) ThreadStats {
+    double cost = 0;
+    uint32_t depth = 0;
+    size_t inner_nodes = 0, leaves = 0, rebalanced = 0;
+  };
+  ThreadStats& stats() { return stats_[size_t(omp_get_thread_num())]; }
 
   void fail(std::exception_ptr e) {
     std::lock_guard<std::mutex> lock(error_mutex_);
@@ -162,9 +167,10 @@ class Emitter {
 
   void* emit_leaf(size_t first, size_t count, uint32_t depth) {
     if (depth > limits_.max_depth) throw DepthLimitError("depth limit reached");
-    note_depth(depth);
-    ++leaves_;
-    add_cost(double(limits_.intersection_cost) * double(count) * box_of(out_ + first, count).surface_area());
+    ThreadStats& s = stats();
+    s.depth = std::max(s.depth, depth);
+    ++s.leaves;
+    s.cost += double(limits_.intersection_cost) * double(count) * box_of(out_ + first, count).surface_area();
     return callbacks_.create_leaf(allocator(), out_ + first, count, callbacks_.user);
   }
 
@@ -173,9 +179,10 @@ class Emitter {
   void* emit_inner(const Aabb& box, const Aabb* boxes, const uint32_t* counts, uint32_t n, uint32_t depth,
                    const EmitChild& emit_child) {
     if (depth >= limits_.max_depth) throw DepthLimitError("depth limit reached");
-    note_depth(depth);
-    ++inner_;
-    add_cost(double(limits_.traversal_cost) * box.surface_area());
+    ThreadStats& s = stats();
+    s.depth = std::max(s.depth, depth);
+    ++s.inner_nodes;
+    s.cost += double(limits_.traversal_cost) * box.surface_area();
     void* node = callbacks_.create_node(allocator(), n, callbacks_.user);
     RTCBounds bounds[kMaxBranching];
     const RTCBounds* bound_ptrs[kMaxBranching];
@@ -184,16 +191,20 @@ class Emitter {
       bound_ptrs[i] = &bounds[i];
     }
     callbacks_.set_bounds(node, bound_ptrs, n, callbacks_.user);
-    void* children[kMaxBranching] = {};
+    void* children[kMaxBranching];
+    bool spawned = false;
     for (uint32_t i = 0; i < n; ++i) {
       if (i + 1 < n && counts[i] >= kTaskPrimitives) {
+        spawned = true;
 #pragma omp task default(shared) firstprivate(i)
         children[i] = emit_child(i);
       } else {
         children[i] = emit_child(i);
       }
     }
+    if (spawned) {
 #pragma omp taskwait
+    }
     if (failed_) return nullptr;
     callbacks_.set_children(node, children, n, callbacks_.user);
     return node;
@@ -205,7 +216,7 @@ class Emitter {
     if (as_leaf_[v] && count <= limits_.max_leaf) return emit_leaf(first_[v], count, depth);
     const bool fits = depth + height_[v] - 1 <= limits_.max_depth;
     if (!fits && (node.is_leaf() || depth + balanced_height(count) - 1 <= limits_.max_depth)) {
-      ++rebalanced_;
+      ++stats().rebalanced;
       return emit_range(first_[v], count, depth);
     }
     if (node.is_leaf()) return emit_range(first_[v], count, depth);  // a leaf larger than max_leaf
@@ -276,9 +287,7 @@ class Emitter {
 
   EmitResult result_;
   double binary_traversal_cost_ = 0;
-  double cost_sum_ = 0;
-  std::atomic<uint32_t> depth_{0};
-  std::atomic<size_t> inner_{0}, leaves_{0}, rebalanced_{0};
+  std::vector<ThreadStats> stats_ = std::vector<ThreadStats>(size_t(omp_get_max_threads()));
   std::mutex error_mutex_;
   std::exception_ptr error_;  // the first failure, under error_mutex_
   std::atomic<bool> failed_{false};
