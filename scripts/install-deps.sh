@@ -11,6 +11,7 @@ packages=(
   libcli11-dev libfmt-dev libspdlog-dev
   libgtest-dev
   embree-tools openimageio-tools
+  clang libclang-rt-14-dev libomp-14-dev
 )
 
 missing=()
