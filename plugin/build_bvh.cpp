@@ -119,10 +119,9 @@ void* build(BvhObject& object, const RTCBuildArguments& a) {
 }  // namespace
 
 void* build_bvh(const RTCBuildArguments* args) {
-  // Fields beyond a shorter byteSize are not there to read: the BVH handle among them.
-  constexpr size_t kNeeded = offsetof(RTCBuildArguments, userPtr) + sizeof(void*);
-  if (!args || args->byteSize < kNeeded) {
-    report_error(nullptr, RTC_ERROR_INVALID_ARGUMENT, args ? "RTCBuildArguments::byteSize is too small" : "invalid argument");
+  // Embree 3 never reads byteSize (an application may leave it 0), and neither does kmbvh.
+  if (!args) {
+    report_error(nullptr, RTC_ERROR_INVALID_ARGUMENT, "invalid argument");
     return nullptr;
   }
   BvhObject* object = BvhObject::from(args->bvh);
