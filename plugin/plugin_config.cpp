@@ -24,6 +24,8 @@ uint32_t env_count(const char* name, uint32_t lo, uint32_t hi) {
   return uint32_t(x);
 }
 
+bool log_requested() { return !env("KMBVH_LOG").empty() && env("KMBVH_LOG") != "0"; }
+
 }  // namespace
 
 PluginConfig read_plugin_config() {
@@ -52,7 +54,7 @@ PluginConfig read_plugin_config() {
     c.backend = Backend::Cuda;
   else if (!backend.empty() && backend != "cpu")
     throw std::invalid_argument("KMBVH_BACKEND=" + backend + ": expected cpu or cuda");
-  c.log = !env("KMBVH_LOG").empty() && env("KMBVH_LOG") != "0";
+  c.log = log_requested();
   return c;
 }
 
@@ -63,7 +65,7 @@ const PluginConfig& plugin_config() {
     } catch (const std::exception& e) {
       std::fprintf(stderr, "kmbvh: %s; using the defaults\n", e.what());
       PluginConfig c;
-      c.log = !env("KMBVH_LOG").empty() && env("KMBVH_LOG") != "0";
+      c.log = log_requested();
       return c;
     }
   }();

@@ -13,7 +13,8 @@ PrimitiveSet primitive_set_from(const RTCBuildPrimitive* primitives, size_t coun
   set.ids.resize(count);
   for (size_t i = 0; i < count; ++i) {
     const RTCBuildPrimitive& p = primitives[i];
-    const Vec3 lo(p.lower_x, p.lower_y, p.lower_z), hi(p.upper_x, p.upper_y, p.upper_z);
+    const Aabb box = box_of(p);
+    const Vec3 &lo = box.lo, &hi = box.hi;
     for (int a = 0; a < 3; ++a) {
       if (!std::isfinite(lo[a]) || !std::isfinite(hi[a]))
         throw std::invalid_argument(fmt::format("primitive {} (geomID {}, primID {}) has a non-finite bound", i,
@@ -22,7 +23,7 @@ PrimitiveSet primitive_set_from(const RTCBuildPrimitive* primitives, size_t coun
         throw std::invalid_argument(fmt::format("primitive {} (geomID {}, primID {}) has lower > upper on axis {}", i,
                                                 p.geomID, p.primID, "xyz"[a]));
     }
-    set.boxes[i] = Aabb{lo, hi};
+    set.boxes[i] = box;
     set.ids[i] = PrimitiveId{p.geomID, p.primID};
   }
   return set;

@@ -8,6 +8,7 @@
 #include <new>
 #include <stdexcept>
 
+#include "build_primitives.h"
 #include "embree_device.h"
 
 namespace kmbvh {
@@ -44,8 +45,7 @@ void set_node_children(void* node_ptr, void** children, unsigned int count, void
 void set_node_bounds(void* node_ptr, const RTCBounds** bounds, unsigned int count, void*) {
   auto* node = static_cast<CapturedInner*>(node_ptr);
   for (unsigned int i = 0; i < count; ++i)
-    node->child_box[i] = Aabb(Vec3(bounds[i]->lower_x, bounds[i]->lower_y, bounds[i]->lower_z),
-                              Vec3(bounds[i]->upper_x, bounds[i]->upper_y, bounds[i]->upper_z));
+    node->child_box[i] = box_of(*bounds[i]);
 }
 
 void* create_leaf(RTCThreadLocalAllocator alloc, const RTCBuildPrimitive* prims, size_t count, void*) {
@@ -112,7 +112,7 @@ Bvh build_embree(const PrimitiveSet& prims, const EmbreeBuildOptions& options, B
   std::vector<RTCBuildPrimitive> input(prims.size());
   for (size_t i = 0; i < prims.size(); ++i) {
     const Aabb& b = prims.boxes[i];
-    input[i] = RTCBuildPrimitive{b.lo.x, b.lo.y, b.lo.z, 0u, b.hi.x, b.hi.y, b.hi.z, uint32_t(i)};
+    input[i] = build_primitive(b, 0, uint32_t(i));
   }
   const double input_ms = ms_since(t);
 

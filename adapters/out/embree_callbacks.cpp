@@ -1,5 +1,7 @@
 #include "embree_callbacks.h"
 
+#include "adapters/embree/build_primitives.h"
+
 #include <omp.h>
 
 #include <algorithm>
@@ -13,18 +15,7 @@ namespace {
 constexpr uint32_t kMaxBranching = 16;       // the widest node Embree 3 makes
 constexpr uint32_t kTaskPrimitives = 4096;   // subtrees this large are emitted as tasks of their own
 
-RTCBounds to_bounds(const Aabb& b) {
-  RTCBounds r;
-  r.lower_x = b.lo.x, r.lower_y = b.lo.y, r.lower_z = b.lo.z, r.align0 = 0;
-  r.upper_x = b.hi.x, r.upper_y = b.hi.y, r.upper_z = b.hi.z, r.align1 = 0;
-  return r;
-}
-
-Aabb box_of(const RTCBuildPrimitive& p) {
-  return Aabb{Vec3(p.lower_x, p.lower_y, p.lower_z), Vec3(p.upper_x, p.upper_y, p.upper_z)};
-}
-
-Aabb box_of(const RTCBuildPrimitive* p, size_t n) {
+Aabb range_box(const RTCBuildPrimitive* p, size_t n) {
   Aabb b;
   for (size_t i = 0; i < n; ++i) b.grow(box_of(p[i]));
   return b;
@@ -170,7 +161,7 @@ class Emitter {
     ThreadStats& s = stats();
     s.depth = std::max(s.depth, depth);
     ++s.leaves;
-    s.cost += double(limits_.intersection_cost) * double(count) * box_of(out_ + first, count).surface_area();
+    s.cost += double(limits_.intersection_cost) * double(count) * range_box(out_ + first, count).surface_area();
     return callbacks_.create_leaf(allocator(), out_ + first, count, callbacks_.user);
   }
 
@@ -187,7 +178,7 @@ class Emitter {
     RTCBounds bounds[kMaxBranching];
     const RTCBounds* bound_ptrs[kMaxBranching];
     for (uint32_t i = 0; i < n; ++i) {
-      bounds[i] = to_bounds(boxes[i]);
+      bounds[i] = bounds_of(boxes[i]);
       bound_ptrs[i] = &bounds[i];
     }
     callbacks_.set_bounds(node, bound_ptrs, n, callbacks_.user);
@@ -268,7 +259,7 @@ class Emitter {
     std::nth_element(p, p + half, p + count, [axis](const RTCBuildPrimitive& a, const RTCBuildPrimitive& b) {
       return box_of(a).center()[axis] < box_of(b).center()[axis];
     });
-    const Aabb boxes[2] = {box_of(p, half), box_of(p + half, count - half)};
+    const Aabb boxes[2] = {range_box(p, half), range_box(p + half, count - half)};
     const uint32_t counts[2] = {uint32_t(half), uint32_t(count - half)};
     const size_t starts[2] = {first, first + half};
     return emit_inner(box, boxes, counts, 2, depth,

@@ -4,15 +4,11 @@
 
 #include <algorithm>
 
+#include "adapters/embree/build_primitives.h"
 #include "adapters/in/triangle_scene.h"
 
 namespace kmbvh::test {
 namespace {
-
-Aabb aabb(const RTCBounds& b) { return Aabb{Vec3(b.lower_x, b.lower_y, b.lower_z), Vec3(b.upper_x, b.upper_y, b.upper_z)}; }
-Aabb aabb(const RTCBuildPrimitive& p) {
-  return Aabb{Vec3(p.lower_x, p.lower_y, p.lower_z), Vec3(p.upper_x, p.upper_y, p.upper_z)};
-}
 
 class Checker {
  public:
@@ -21,7 +17,7 @@ class Checker {
 
   AppTreeReport run(const app::Node* root) {
     Aabb all;
-    for (const RTCBuildPrimitive& p : input_) all.grow(aabb(p));
+    for (const RTCBuildPrimitive& p : input_) all.grow(box_of(p));
     const Aabb content = walk(root, all, 1);
     if (report_.ok() && report_.primitives != input_.size())
       report_.problem = fmt::format("{} of {} primitives in the tree", report_.primitives, input_.size());
@@ -57,7 +53,7 @@ class Checker {
           continue;
         }
         ++report_.primitives;
-        content.grow(aabb(input_[id]));
+        content.grow(box_of(input_[id]));
       }
       cost_ += double(args_.intersectionCost) * leaf->prim_count * given.surface_area();
       if (leaf->prim_count && !given.contains(content)) fail("a leaf's primitives outside the bounds it was given");
@@ -72,7 +68,7 @@ class Checker {
     cost_ += double(args_.traversalCost) * given.surface_area();
     Aabb content;
     for (uint32_t i = 0; i < inner->child_count && i < app::Inner::kWidest; ++i) {
-      const Aabb child_given = aabb(inner->bounds[i]);
+      const Aabb child_given = box_of(inner->bounds[i]);
       if (!given.contains(child_given)) fail("a child's bounds outside its parent's");
       const Aabb child = walk(inner->children[i], child_given, depth + 1);
       if (!child.is_empty() && !child_given.contains(child)) fail("a subtree outside the bounds it was given");
@@ -98,8 +94,7 @@ AppTreeReport check_app_tree(const app::Node* root, const std::vector<RTCBuildPr
 std::vector<RTCBuildPrimitive> build_primitives_of(const TriangleScene& scene) {
   std::vector<RTCBuildPrimitive> prims(scene.size());
   for (size_t i = 0; i < scene.size(); ++i) {
-    const Aabb b = scene.triangle_box(i);
-    prims[i] = RTCBuildPrimitive{b.lo.x, b.lo.y, b.lo.z, 0, b.hi.x, b.hi.y, b.hi.z, uint32_t(i)};
+    prims[i] = build_primitive(scene.triangle_box(i), 0, uint32_t(i));
   }
   return prims;
 }
