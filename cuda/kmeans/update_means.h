@@ -21,14 +21,22 @@ struct FixedPointFrame {
     FixedPointFrame f;
     f.lo = box.lo;
     const Vec3 e = box.extent();
-    for (int d = 0; d < 3; ++d) f.scale[d] = e[d] > 0.0f ? 2147483648.0f / e[d] : 0.0f;
+    for (int d = 0; d < 3; ++d) {
+      // An extent below 2^31 / FLT_MAX (about 6e-30) would make the scale infinite: the
+      // node is flat on that axis for the means' purposes.
+      const float s = e[d] > 0.0f ? 2147483648.0f / e[d] : 0.0f;
+      f.scale[d] = s <= 3.4028234e38f ? s : 0.0f;
+    }
     return f;
   }
 
-  // sum: plain sum of `count` coordinates inside the frame, on axis d.
+  // sum: plain sum of `count` coordinates inside the frame, on axis d. The result stays
+  // below 2^63 (count * 2^31 at most for members inside the frame); anything else is
+  // clamped there rather than converted out of range.
   KMBVH_HD unsigned long long encode(double sum, uint32_t count, int d) const {
     const double v = (sum - double(count) * double(lo[d])) * double(scale[d]);
-    return v > 0.0 ? static_cast<unsigned long long>(v + 0.5) : 0ull;  // NaN and negatives: 0
+    if (!(v > 0.0)) return 0ull;  // NaN and negatives: 0
+    return v < 9.2233720368547758e18 ? static_cast<unsigned long long>(v + 0.5) : (1ull << 63);
   }
 
   KMBVH_HD float decode_mean(unsigned long long sum, uint32_t count, int d) const {
