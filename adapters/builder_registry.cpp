@@ -37,7 +37,11 @@ std::string BuilderConfig::label() const {
   const std::string medians = kmeans.metric == ClusterMetric::Medians ? " medians" : "";
   const std::string wide = kmeans.wide ? " wide" : "";
   if (!preset.empty()) return fmt::format("kmeans {}{}{}", preset, medians, wide);
-  return fmt::format("kmeans k={} p={} i={}{}{}", kmeans.k, kmeans.p, kmeans.i, medians, wide);
+  const std::string adaptive = kmeans.adaptive ? " adaptive" : "";
+  const std::string stable = !kmeans.until_stable         ? ""
+                             : kmeans.settle_fraction > 0 ? fmt::format(" until-stable({:g})", kmeans.settle_fraction)
+                                                          : " until-stable";
+  return fmt::format("kmeans k={} p={} i={}{}{}{}{}", kmeans.k, kmeans.p, kmeans.i, adaptive, stable, medians, wide);
 }
 
 const std::vector<std::string>& builder_names() {
@@ -60,20 +64,20 @@ BuilderConfig parse_builder(const std::string& spec) {
   EmbreeQuality quality;
   if (name == "kmeans") {
     const auto params = kmeans_preset(preset);
-    if (!params) throw std::invalid_argument(fmt::format("unknown k-means preset '{}' (Q1 to Q5)", preset));
+    if (!params) throw std::invalid_argument(fmt::format("unknown k-means preset '{}' (Q1 to Q5, QA)", preset));
     config.kmeans = *params;
     config.preset = preset;
     for (char& c : config.preset) c = char(std::toupper(static_cast<unsigned char>(c)));
   } else if (!is_embree(name, &quality) && !is_binary(name) && name != "sweep-sah") {
     throw std::invalid_argument(fmt::format(
-        "unknown builder '{}' (sweep-sah, lbvh, hlbvh, atrbvh, ploc, kmeans, Q1..Q5, embree-low|medium|high)", spec));
+        "unknown builder '{}' (sweep-sah, lbvh, hlbvh, atrbvh, ploc, kmeans, Q1..Q5, QA, embree-low|medium|high)", spec));
   }
   return config;
 }
 
 std::vector<BuilderConfig> all_builders() {
   std::vector<BuilderConfig> all;
-  for (const char* spec : {"sweep-sah", "lbvh", "hlbvh", "atrbvh", "ploc", "Q1", "Q2", "Q3", "Q4", "Q5", "embree-low",
+  for (const char* spec : {"sweep-sah", "lbvh", "hlbvh", "atrbvh", "ploc", "Q1", "Q2", "Q3", "Q4", "Q5", "QA", "embree-low",
                            "embree-medium", "embree-high"})
     all.push_back(parse_builder(spec));
   return all;

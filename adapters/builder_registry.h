@@ -34,7 +34,7 @@ const std::vector<std::string>& builder_names();
 BuilderConfig parse_builder(const std::string& spec);
 
 // Every builder, as `kmbvh bench --builders all` runs them: the references first, then
-// k-means Q1-Q5, then Embree's.
+// k-means Q1-Q5 and the adaptive QA, then Embree's.
 std::vector<BuilderConfig> all_builders();
 
 // Throws std::invalid_argument saying what is wrong with the configuration for its builder

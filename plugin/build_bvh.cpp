@@ -100,6 +100,11 @@ void* build(BvhObject& object, const RTCBuildArguments& a) {
   limits.intersection_cost = a.intersectionCost;
   const EmbreeCallbacks callbacks{a.createNode, a.setNodeChildren, a.setNodeBounds, a.createLeaf, a.userPtr};
   EmitResult emitted;
+  struct Emitting {  // cleared however the emission ends
+    BvhObject& object;
+    explicit Emitting(BvhObject& o) : object(o) { object.set_emitting(true); }
+    ~Emitting() { object.set_emitting(false); }
+  } emitting(object);
   try {
     emitted = emit_to_callbacks(bvh, prims, a.primitives, limits, callbacks, allocators);
   } catch (const DepthLimitError& e) {

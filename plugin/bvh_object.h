@@ -24,6 +24,7 @@ class Arena {
   // Throws std::bad_alloc for sizes no machine has.
   void* allocate(size_t bytes, size_t align);
   RTCDevice device() const;
+  BvhObject& owner() const { return *owner_; }
 
  private:
   BvhObject* owner_;
@@ -57,10 +58,17 @@ class BvhObject {
   std::pair<char*, size_t> new_block(size_t at_least);
   size_t block_bytes() const { return block_bytes_; }
 
+  // Whether kmbvh is calling the application's callbacks for a build of this object (an
+  // allocation failure then unwinds to rtcBuildBVH, as in Embree, instead of handing the
+  // callback a null node).
+  void set_emitting(bool emitting) { emitting_.store(emitting, std::memory_order_relaxed); }
+  bool emitting() const { return emitting_.load(std::memory_order_relaxed); }
+
  private:
   static constexpr unsigned kTag = 0x6b6d6268;  // "kmbh": tells kmbvh's objects from others
   unsigned tag_ = kTag;
   std::atomic<int> refs_{1};
+  std::atomic<bool> emitting_{false};
   RTCDevice device_;
   size_t block_bytes_ = 64 << 10;
   std::mutex blocks_mutex_;

@@ -28,9 +28,16 @@ void* kmbvhThreadLocalAlloc(RTCThreadLocalAllocator allocator, size_t bytes, siz
     return nullptr;
   }
   auto* arena = reinterpret_cast<kmbvh::plugin::Arena*>(allocator);
-  void* p = nullptr;
-  kmbvh::plugin::guarded(arena->device(), [&] { p = arena->allocate(bytes, align); });
-  return p;
+  try {
+    return arena->allocate(bytes, align);
+  } catch (const std::bad_alloc&) {
+    // Inside kmbvh's build, as inside Embree's, the failure unwinds through the
+    // application's callback to rtcBuildBVH, which reports it: the callback would otherwise
+    // write its node through a null pointer.
+    if (arena->owner().emitting()) throw;
+    report_error(arena->device(), RTC_ERROR_OUT_OF_MEMORY, "out of memory");
+  }
+  return nullptr;
 }
 
 void kmbvhRetainBVH(RTCBVH handle) {

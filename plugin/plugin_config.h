@@ -31,7 +31,7 @@ PluginConfig read_plugin_config();
 // defaults are used.
 const PluginConfig& plugin_config();
 
-// The builder for one build of the given quality (LOW: Q1, MEDIUM: Q3, HIGH: Q5 for
+// The builder for one build of the given quality (LOW: Q1, MEDIUM: Q3, HIGH: QA for
 // k-means, unless KMBVH_PRESET/K/P/I say otherwise).
 BuilderConfig builder_for(const PluginConfig& config, RTCBuildQuality quality);
 

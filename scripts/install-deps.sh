@@ -12,6 +12,7 @@ packages=(
   libgtest-dev
   embree-tools openimageio-tools
   clang libclang-rt-14-dev libomp-14-dev
+  python3-matplotlib
 )
 
 missing=()

@@ -152,3 +152,28 @@ TEST(Cli, TraceRejectsAnUnknownLayout) {
 }
 
 }  // namespace
+
+TEST(Cli, StressWritesJsonAndTheMarkdownSummary) {
+  const fs::path md = kmbvh::test::temp_path("stress.md");
+  const Result r = run("stress one needles --builders sweep-sah,Q2,QA,embree-medium --triangles 500 --rays 200 --json "
+                       "--markdown " + md.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto rows = nlohmann::json::parse(r.out);
+  ASSERT_EQ(rows.size(), 8u);
+  for (const auto& row : rows) {
+    for (const char* field : {"case", "triangles", "builder", "kmbvh", "outcome", "message", "build_ms", "sah_cost",
+                              "sah_over_sweep", "max_depth", "max_leaf_size", "rays", "mismatches"})
+      EXPECT_TRUE(row.contains(field)) << field;
+    EXPECT_EQ(row["outcome"], "ok") << row.dump();
+  }
+  std::ifstream in(md);
+  const std::string table((std::istreambuf_iterator<char>(in)), {});
+  EXPECT_NE(table.find("| needles | 500 |"), std::string::npos) << table;
+  EXPECT_NE(table.find("kmeans QA"), std::string::npos) << table;
+}
+
+TEST(Cli, StressRejectsAnUnknownCase) {
+  const Result r = run("stress no-such-case");
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("unknown stress case 'no-such-case'"), std::string::npos) << r.err;
+}

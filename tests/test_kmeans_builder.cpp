@@ -7,6 +7,7 @@
 
 #include "cuda/core/threads.h"
 #include "cuda/kmeans/kmeans_builder.h"
+#include "cuda/kmeans/node_rules.h"
 #include "cuda/metrics/tree_stats.h"
 #include "cuda/metrics/validate.h"
 #include "support/scenes.h"
@@ -86,7 +87,7 @@ TEST_P(EveryPreset, CpuSubtreePathBuildsTheLevelLoopsTree) {
       }
 }
 
-INSTANTIATE_TEST_SUITE_P(KMeans, EveryPreset, ::testing::Values("Q1", "Q2", "Q3", "Q4", "Q5"));
+INSTANTIATE_TEST_SUITE_P(KMeans, EveryPreset, ::testing::Values("Q1", "Q2", "Q3", "Q4", "Q5", "QA"));
 
 TEST(KMeansBuilder, FreeParameters) {
   const PrimitiveSet prims = make_primitive_set(test::random_triangles(5000, 4));
@@ -104,6 +105,47 @@ TEST(KMeansBuilder, FreeParameters) {
     params.wide = true;
     expect_valid(prims, params, "free parameters");
   }
+}
+
+// Stopping a node's Lloyd loop at a fixed point (no assignment changed) cannot change the
+// tree: the remaining iterations would reproduce the same means. With a settle fraction,
+// the loop stops earlier and the tree may differ, but it stays valid.
+TEST(KMeansBuilder, UntilStableAtAFixedPointBuildsTheSameTree) {
+  const PrimitiveSet prims = make_primitive_set(test::clustered_triangles(30000, 8));
+  for (ClusterMetric metric : {ClusterMetric::Means, ClusterMetric::Medians})
+    for (const char* preset : {"Q3", "Q5"}) {
+      KMeansParams params = *kmeans_preset(preset);
+      params.metric = metric;
+      const Bvh full = build_kmeans(prims, params);
+      params.until_stable = true;
+      EXPECT_TRUE(same_tree(full, build_kmeans(prims, params))) << preset << " " << to_string(metric);
+      params.settle_fraction = 0.05f;
+      expect_valid(prims, params, "settled at 5%");
+    }
+}
+
+TEST(KMeansBuilder, AdaptivePresetChoosesKPAndIterationsFromTheNodeSize) {
+  const KMeansParams qa = *kmeans_preset("qa");
+  EXPECT_TRUE(qa.adaptive && qa.until_stable);
+  EXPECT_GT(qa.settle_fraction, 0.0f);
+  const NodeRules rules = node_rules(qa);
+  EXPECT_EQ(rules.child_k(qa.max_leaf_size * 64), 64u);
+  EXPECT_EQ(rules.child_k(1000000), 64u);
+  EXPECT_EQ(rules.child_k(qa.max_leaf_size * 8), 8u);
+  EXPECT_EQ(rules.child_k(qa.max_leaf_size * 8 - 1), 4u);
+  EXPECT_EQ(rules.child_k(qa.max_leaf_size + 1), 2u);
+  EXPECT_EQ(rules.candidates(64), 30u);
+  EXPECT_EQ(rules.candidates(16), 8u);
+  EXPECT_EQ(rules.candidates(2), 5u);
+  EXPECT_EQ(rules.iterations(64), 4u);  // 256 / k, within [2, i]
+  EXPECT_EQ(rules.iterations(16), 15u);
+  EXPECT_EQ(rules.iterations(2), 15u);
+  // The paper's rule for the presets: k, and 2 below m * k.
+  const NodeRules q5 = node_rules(*kmeans_preset("Q5"));
+  EXPECT_EQ(q5.child_k(q5.max_leaf_size * 64), 64u);
+  EXPECT_EQ(q5.child_k(q5.max_leaf_size * 64 - 1), 2u);
+  EXPECT_EQ(q5.iterations(64), 15u);
+  EXPECT_EQ(q5.candidates(2), 30u);
 }
 
 TEST(KMeansBuilder, SeedChangesTreeButNotValidity) {
@@ -192,7 +234,7 @@ TEST_P(Degenerate, SharedCentroidAndZeroArea) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(KMeans, Degenerate, ::testing::Values("Q1", "Q2", "Q3", "Q4", "Q5"));
+INSTANTIATE_TEST_SUITE_P(KMeans, Degenerate, ::testing::Values("Q1", "Q2", "Q3", "Q4", "Q5", "QA"));
 
 }  // namespace
 }  // namespace kmbvh

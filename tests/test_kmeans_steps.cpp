@@ -182,9 +182,10 @@ TEST(UpdateMedians, RepresentativeIsComponentwiseLowerMedian) {
   std::vector<Aabb> members = {Aabb({0, 5, 1}, {1, 6, 9}), Aabb({3, 1, 2}, {4, 2, 3}), Aabb({2, 0, 0}, {5, 7, 4}),
                                Aabb({1, 1, 1}, {2, 2, 2})};
   Aabb rep;
-  uint32_t count = 4, begin = 0;
-  ClusterArrays clusters{&rep, nullptr, &count, nullptr, &begin, nullptr};
-  UpdateMedians{members.data(), clusters}(0);
+  uint32_t count = 4, begin = 0, segment = 0;
+  Segment seg;
+  ClusterArrays clusters{&rep, nullptr, &count, nullptr, &begin, &segment};
+  UpdateMedians{members.data(), &seg, clusters}(0);
   // lower medians (rank 1 of 4) per component
   EXPECT_EQ(rep, Aabb({1, 1, 1}, {2, 2, 3}));
 }

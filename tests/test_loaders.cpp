@@ -201,3 +201,92 @@ TEST(PrimitiveSet, DropsNonFiniteTriangles) {
 
 }  // namespace
 }  // namespace kmbvh
+
+namespace kmbvh {
+namespace {
+
+// Every broken file gives one line naming the file and the problem (and `kmbvh` exits 2 on
+// it, test_cli.cpp), without a crash and without allocating what the file claims.
+struct BadFile {
+  std::string name;
+  std::string expected;  // a part of the message
+  fs::path path;
+};
+
+fs::path glb_with(const std::string& name, const std::function<void(tinygltf::Model&)>& change) {
+  tinygltf::Model m = three_node_model();
+  change(m);
+  return write_model(m, name, true);
+}
+
+std::vector<BadFile> bad_files() {
+  std::vector<BadFile> files;
+  auto obj = [&](const std::string& name, const std::string& text, const std::string& expected) {
+    const fs::path path = temp_file(name);
+    std::ofstream(path, std::ios::binary) << text;
+    files.push_back({name, expected, path});
+  };
+  const std::string tri = "v 0 0 0\nv 1 0 0\nv 0 1 0\n";
+  obj("cut-face.obj", tri + "f 1 2", "line 4: a face needs at least three vertices");
+  obj("cut-vertex.obj", "v 0 0 0\nv 1 0 0\nv 0 1", "line 3: a vertex needs three coordinates");
+  obj("word-vertex.obj", "v a b c\n" + tri + "f 1 2 3\n", "line 1: 'a' is not a number");
+  obj("zero-index.obj", tri + "f 0 1 2\n", "'0' is not a vertex reference");
+  obj("huge-index.obj", tri + "f 1 2 99999999999\n", "'99999999999' is not a vertex reference");
+  obj("past-index.obj", tri + "f 1 2 4\n", "refers to vertex 4 of 3");
+  obj("before-first.obj", tri + "f -5 -6 -7\n", "refers to vertex");
+  const char binary[] = "f 1 2 3\n\x01\x02\x03\x00\xff garbage";
+  obj("binary.obj", tri + std::string(binary, sizeof binary - 1), "line 5: binary data");
+
+  auto glb = [&](const std::string& name, const std::string& expected, const std::function<void(tinygltf::Model&)>& f) {
+    files.push_back({name, expected, glb_with(name, f)});
+  };
+  glb("absurd-count.glb", "runs past its buffer view", [](tinygltf::Model& m) { m.accessors[0].count = size_t(1) << 31; });
+  glb("absurd-index-count.glb", "flattens to 3999999999 triangles",
+      [](tinygltf::Model& m) { m.accessors[1].count = 4000000000u; });
+  glb("view-past-buffer.glb", "past its buffer", [](tinygltf::Model& m) { m.bufferViews[1].byteOffset = 1 << 20; });
+  glb("missing-mesh.glb", "mesh 5 does not exist", [](tinygltf::Model& m) { m.nodes[0].mesh = 5; });
+  glb("missing-accessor.glb", "accessor 9 does not exist",
+      [](tinygltf::Model& m) { m.meshes[0].primitives[0].attributes["POSITION"] = 9; });
+  glb("node-cycle.glb", "node 1 is its own ancestor (a cycle)", [](tinygltf::Model& m) { m.nodes[2].children = {1}; });
+  glb("node-dag.glb", "more than 16777216 (a node reused", [](tinygltf::Model& m) {
+    // 40 levels, each node referring to the next one twice: 2^40 instances of the mesh.
+    const int first = int(m.nodes.size());
+    for (int level = 0; level < 40; ++level) {
+      tinygltf::Node n;
+      n.mesh = 0;
+      if (level + 1 < 40) n.children = {first + level + 1, first + level + 1};
+      m.nodes.push_back(n);
+    }
+    m.scenes[0].nodes = {first};
+  });
+  glb("bad-component-type.glb", "componentType", [](tinygltf::Model& m) {
+    m.accessors[1].componentType = TINYGLTF_COMPONENT_TYPE_UNSIGNED_BYTE + 100;  // not a component type
+  });
+
+  // A .glb whose header and chunk claim 4 GB.
+  const fs::path good = write_model(three_node_model(), "good-for-header.glb", true);
+  std::string bytes;
+  {
+    std::ifstream in(good, std::ios::binary);
+    bytes.assign(std::istreambuf_iterator<char>(in), {});
+  }
+  const fs::path huge = temp_file("absurd-header.glb");
+  std::string patched = bytes;
+  for (int i : {8, 12}) std::memset(&patched[i], 0xff, 4);
+  std::ofstream(huge, std::ios::binary) << patched;
+  files.push_back({"absurd-header.glb", "", huge});
+  return files;
+}
+
+TEST(BadFiles, EveryOneIsAOneLineErrorNamingTheFileAndTheProblem) {
+  for (const BadFile& f : bad_files()) {
+    const std::string error = load_error(f.path);
+    EXPECT_FALSE(error.empty()) << f.name << " loaded without an error";
+    EXPECT_NE(error.find(f.path.string()), std::string::npos) << f.name << ": " << error;
+    EXPECT_NE(error.find(f.expected), std::string::npos) << f.name << ": " << error;
+    EXPECT_EQ(error.find('\n'), std::string::npos) << f.name << ": one line: " << error;
+  }
+}
+
+}  // namespace
+}  // namespace kmbvh

@@ -30,7 +30,8 @@ struct HostLevel {
     return {reps.data(), sums.data(), counts.data(), bounds.data(), begin.data(), cluster_segment.data()};
   }
   LevelView view() {
-    return {boxes.data(), ids.data(), cluster_of.data(), segments.data(), pieces.data(), counters.data(), clusters()};
+    return {boxes.data(), ids.data(), cluster_of.data(), segments.data(), pieces.data(), counters.data(), clusters(),
+            /*per_node=*/false};
   }
 };
 

@@ -21,6 +21,11 @@ namespace {
 
 constexpr int kModeTriangles = 4, kModeStrip = 5, kModeFan = 6;
 constexpr int kMaxNodeDepth = 512;
+// Bounds on what flattening may make, checked before anything is read (count_flattened).
+constexpr uint64_t kMaxNodeInstances = uint64_t(1) << 24;
+constexpr uint64_t kMaxTriangles = uint64_t(1) << 28;
+
+uint64_t saturating_add(uint64_t a, uint64_t b) { return a > ~uint64_t(0) - b ? ~uint64_t(0) : a + b; }
 
 std::string one_line(std::string s) {
   std::replace(s.begin(), s.end(), '\n', ' ');
@@ -54,18 +59,23 @@ class GltfReader {
       : model_(model), path_(path), scene_(scene) {}
 
   void read() {
+    std::vector<int> roots;
     if (!model_.scenes.empty()) {
       const int s = model_.defaultScene >= 0 ? model_.defaultScene : 0;
       if (s >= int(model_.scenes.size())) fail(fmt::format("default scene {} does not exist", s));
-      for (int node : model_.scenes[s].nodes) visit(node, glm::dmat4(1.0), 0);
-    } else if (!model_.nodes.empty()) {
+      roots = model_.scenes[s].nodes;
+    } else {
       // No scene: every node that is no other node's child is a root.
       std::vector<bool> is_child(model_.nodes.size(), false);
       for (const auto& n : model_.nodes)
         for (int c : n.children)
           if (c >= 0 && c < int(is_child.size())) is_child[c] = true;
       for (int i = 0; i < int(model_.nodes.size()); ++i)
-        if (!is_child[i]) visit(i, glm::dmat4(1.0), 0);
+        if (!is_child[i]) roots.push_back(i);
+    }
+    if (!model_.nodes.empty()) {
+      count_flattened(roots);
+      for (int node : roots) visit(node, glm::dmat4(1.0), 0);
     } else {
       for (int m = 0; m < int(model_.meshes.size()); ++m) add_mesh(m, glm::dmat4(1.0));
     }
@@ -84,6 +94,62 @@ class GltfReader {
       m *= glm::mat4_cast(glm::dquat(node.rotation[3], node.rotation[0], node.rotation[1], node.rotation[2]));
     if (node.scale.size() == 3) m = glm::scale(m, glm::dvec3(node.scale[0], node.scale[1], node.scale[2]));
     return m;
+  }
+
+  struct Flattened {
+    uint64_t instances = 0, triangles = 0;
+    void add(const Flattened& o) {
+      instances = saturating_add(instances, o.instances);
+      triangles = saturating_add(triangles, o.triangles);
+    }
+  };
+
+  // A node graph may reuse a node under many parents: 40 levels, each referring to the next
+  // node twice, instance its mesh 2^40 times. So the instances and triangles that
+  // flattening would make are counted first, memoised per node (saturating), and a graph
+  // that makes too many, or has a cycle, is refused before anything is allocated for it.
+  void count_flattened(const std::vector<int>& roots) const {
+    std::vector<Flattened> memo(model_.nodes.size());
+    std::vector<uint8_t> state(model_.nodes.size(), 0);  // 0 not seen, 1 on the current path, 2 counted
+    Flattened total;
+    for (int root : roots) total.add(count_under(root, memo, state, 0));
+    if (total.instances > kMaxNodeInstances)
+      fail(fmt::format("the node hierarchy makes {} node instances, more than {} (a node reused under too many "
+                       "parents)", total.instances, kMaxNodeInstances));
+    if (total.triangles > kMaxTriangles)
+      fail(fmt::format("the scene flattens to {} triangles, more than {}", total.triangles, kMaxTriangles));
+  }
+
+  Flattened count_under(int index, std::vector<Flattened>& memo, std::vector<uint8_t>& state, int depth) const {
+    if (index < 0 || index >= int(model_.nodes.size())) fail(fmt::format("node {} does not exist", index));
+    if (state[index] == 1) fail(fmt::format("node {} is its own ancestor (a cycle)", index));
+    if (state[index] == 2) return memo[index];
+    if (depth > kMaxNodeDepth) fail(fmt::format("node hierarchy deeper than {}", kMaxNodeDepth));
+    state[index] = 1;
+    const tinygltf::Node& node = model_.nodes[index];
+    Flattened f{1, mesh_triangles(node.mesh)};
+    for (int child : node.children) f.add(count_under(child, memo, state, depth + 1));
+    state[index] = 2;
+    return memo[index] = f;
+  }
+
+  // Triangles a mesh will give, from its accessors' counts (read_* checks them later).
+  uint64_t mesh_triangles(int mesh_index) const {
+    if (mesh_index < 0 || mesh_index >= int(model_.meshes.size())) return 0;
+    uint64_t triangles = 0;
+    for (const tinygltf::Primitive& prim : model_.meshes[mesh_index].primitives) {
+      int accessor = prim.indices;
+      if (accessor < 0) {
+        const auto position = prim.attributes.find("POSITION");
+        accessor = position == prim.attributes.end() ? -1 : position->second;
+      }
+      if (accessor < 0 || accessor >= int(model_.accessors.size())) continue;
+      const uint64_t count = model_.accessors[accessor].count;
+      const int mode = prim.mode < 0 ? kModeTriangles : prim.mode;
+      if (mode == kModeTriangles) triangles = saturating_add(triangles, count / 3);
+      if ((mode == kModeStrip || mode == kModeFan) && count > 2) triangles = saturating_add(triangles, count - 2);
+    }
+    return triangles;
   }
 
   void visit(int index, const glm::dmat4& parent, int depth) {

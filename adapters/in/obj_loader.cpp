@@ -4,7 +4,13 @@
 #include <tiny_obj_loader.h>
 
 #include <algorithm>
+#include <cerrno>
+#include <cstdlib>
 #include <filesystem>
+#include <fstream>
+#include <limits>
+#include <sstream>
+#include <vector>
 
 #include "load_scene.h"
 
@@ -17,11 +23,59 @@ std::string one_line(std::string s) {
   return s;
 }
 
+std::string excerpt(const std::string& line) {
+  return line.size() <= 40 ? "'" + line + "'" : "'" + line.substr(0, 37) + "...'";
+}
+
+// tinyobjloader reads what it can and fills the rest with zeros: "v 1 2" becomes (1, 2, 0),
+// "v a b c" the origin, a face cut short or binary garbage nothing at all. A file that is
+// truncated or malformed must be an error naming its line instead, so the lines that make
+// geometry are checked first: a vertex has three numbers, a face three or more vertex
+// references, each a non-zero integer in range of an int.
+void check_lines(const std::string& path) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw SceneError(fmt::format("{}: cannot be read", path));
+  std::string line;
+  for (size_t number = 1; std::getline(in, line); ++number) {
+    auto fail = [&](const std::string& problem) {
+      throw SceneError(fmt::format("{}: line {}: {}", path, number, problem));
+    };
+    for (const char c : line)
+      if ((static_cast<unsigned char>(c) < 0x20 && c != '\t' && c != '\r' && c != '\f' && c != '\v') || c == 0x7f)
+        fail("binary data, not OBJ text");
+    std::istringstream tokens(line);
+    std::string command, token;
+    tokens >> command;
+    std::vector<std::string> args;
+    while (tokens >> token) args.push_back(token);
+    if (command == "v") {
+      if (args.size() < 3) fail(fmt::format("a vertex needs three coordinates: {}", excerpt(line)));
+      for (size_t a = 0; a < 3; ++a) {
+        char* end = nullptr;
+        std::strtof(args[a].c_str(), &end);
+        if (end == args[a].c_str() || *end != '\0') fail(fmt::format("'{}' is not a number", args[a]));
+      }
+    } else if (command == "f") {
+      if (args.size() < 3) fail(fmt::format("a face needs at least three vertices: {}", excerpt(line)));
+      for (const std::string& ref : args) {
+        const std::string index = ref.substr(0, ref.find('/'));
+        errno = 0;
+        char* end = nullptr;
+        const long value = std::strtol(index.c_str(), &end, 10);
+        if (end == index.c_str() || *end != '\0' || errno == ERANGE || value == 0 ||
+            value < std::numeric_limits<int>::min() + 1 || value > std::numeric_limits<int>::max())
+          fail(fmt::format("'{}' is not a vertex reference (a non-zero integer)", ref));
+      }
+    }
+  }
+}
+
 }  // namespace
 
 TriangleScene load_obj(const std::string& path) {
   std::error_code ec;
   if (!std::filesystem::is_regular_file(path, ec)) throw SceneError(fmt::format("{}: no such file", path));
+  check_lines(path);
   tinyobj::ObjReaderConfig config;
   config.triangulate = false;
   config.vertex_color = false;

@@ -6,6 +6,7 @@
 #include <cstring>
 #include <type_traits>
 
+#include "cuda/core/parallel_errors.h"
 #include "cuda/traversal/ray_box.h"
 #include "cuda/traversal/watertight.h"
 
@@ -93,10 +94,11 @@ inline unsigned enter_children(const WideNode<W>& n, const WideRay<W>& r, float 
 
 // The watertight test's per-ray set-up, broadcast to the slots of a pack.
 struct PackRay {
+  const Ray& ray;  // for the exact check of accepted hits
   RayShear shear;
   vfp org[3];  // the origin's kx, ky, kz components
   vfp sx, sy, sz;
-  explicit PackRay(const Ray& ray) : shear(ray) {
+  explicit PackRay(const Ray& r) : ray(r), shear(r) {
     org[0] = vfp{} + ray.org[shear.kx];
     org[1] = vfp{} + ray.org[shear.ky];
     org[2] = vfp{} + ray.org[shear.kz];
@@ -136,21 +138,24 @@ inline int intersect_pack(const TrianglePack& p, const PackRay& r, float tnear, 
   const vip exact_zero = (U == zero) | (V == zero) | (W == zero);
   unsigned hits = mask_bits(valid & ~exact_zero) & ~skip;
   unsigned redo = mask_bits(exact_zero) & ~skip;
+  auto vertex = [&](int v, int slot) { return Vec3(p.v[v][0][slot], p.v[v][1][slot], p.v[v][2][slot]); };
+  auto exact = [&](int slot) {  // watertight.h: exact_t_within
+    return exact_t_within(r.ray, vertex(0, slot), vertex(1, slot), vertex(2, slot), tnear, tmax);
+  };
   int best = -1;
   if (hits) {
     const vfp t = T / det;
     for (; hits; hits &= hits - 1) {
       const int slot = __builtin_ctz(hits);
-      if (best < 0 || t[slot] < t_hit) best = slot, t_hit = t[slot];
+      if ((best < 0 || t[slot] < t_hit) && exact(slot)) best = slot, t_hit = t[slot];
     }
   }
   for (; redo; redo &= redo - 1) {
     const int slot = __builtin_ctz(redo);
-    const Vec3 a(p.v[0][0][slot], p.v[0][1][slot], p.v[0][2][slot]);
-    const Vec3 b(p.v[1][0][slot], p.v[1][1][slot], p.v[1][2][slot]);
-    const Vec3 c(p.v[2][0][slot], p.v[2][1][slot], p.v[2][2][slot]);
     Hit h;
-    if (intersect_watertight(s, tnear, best < 0 ? tmax : t_hit, a, b, c, h)) best = slot, t_hit = h.t;
+    if (intersect_watertight(s, tnear, best < 0 ? tmax : t_hit, vertex(0, slot), vertex(1, slot), vertex(2, slot), h) &&
+        exact(slot))
+      best = slot, t_hit = h.t;
   }
   return best;
 }
@@ -282,12 +287,16 @@ template <int W>
 void trace_wide(const WideBvh<W>& bvh, const std::vector<Ray>& rays, Query query, std::vector<Hit>& hits) {
   hits.resize(rays.size());
   const size_t n = rays.size();
+  ParallelErrors errors;
 #pragma omp parallel
   {
-    std::vector<WideEntry> stack(bvh.stack_size);
+    std::vector<WideEntry> stack;
+    errors.capture([&] { stack.resize(bvh.stack_size); });
 #pragma omp for schedule(dynamic, 256)
-    for (size_t i = 0; i < n; ++i) trace_wide_ray(bvh, rays[i], query, stack.data(), hits[i]);
+    for (size_t i = 0; i < n; ++i)
+      if (!errors.failed()) trace_wide_ray(bvh, rays[i], query, stack.data(), hits[i]);
   }
+  errors.rethrow();
 }
 
 template bool trace_wide_ray<4>(const WideBvh<4>&, const Ray&, Query, WideEntry*, Hit&);

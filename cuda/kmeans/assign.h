@@ -112,6 +112,10 @@ struct AssignPiece {
     const Piece piece = level.pieces[piece_index];
     const Segment seg = level.segments[piece.segment];
     if (Pass == AssignPass::SplitByIndex && !seg.split_by_index) return;
+    // A stable segment's sums would only reproduce its means (UpdateMeans keeps the
+    // representatives of clusters left empty).
+    if (Pass == AssignPass::Sums && level.per_node && seg.stable) return;
+    const bool count_changes = Pass != AssignPass::SplitByIndex && level.per_node;
     const uint32_t k = seg.k;
 
     RepresentativeTable<KMax, M> table;
@@ -123,6 +127,7 @@ struct AssignPiece {
     acc.clear(k);
     uint32_t count[KMax];
     for (uint32_t c = 0; c < k; ++c) count[c] = 0;
+    uint32_t changed = 0;
 
     for (uint32_t i = piece.begin; i < piece.end; ++i) {
       const Aabb b = level.boxes[i];
@@ -131,6 +136,7 @@ struct AssignPiece {
         c = static_cast<uint32_t>((uint64_t(i - seg.begin) * k) / seg.count);
       else
         c = table.nearest(b);
+      if (count_changes) changed += level.cluster_of[i] != c;
       level.cluster_of[i] = static_cast<uint8_t>(c);
       ++count[c];
       acc.add(c, b);
@@ -139,6 +145,7 @@ struct AssignPiece {
     // Publish per cluster: atomics where several pieces share the segment.
     const FixedPointFrame frame = FixedPointFrame::of(seg.box);
     const bool sole = seg.piece_count == 1;
+    if (changed != 0) atomic_add(&level.segments[piece.segment].changed, changed);
     for (uint32_t c = 0; c < k; ++c) {
       if constexpr (Pass != AssignPass::Sums) level.piece_counters[piece.counter_base + c] = count[c];
       if (count[c] == 0) continue;

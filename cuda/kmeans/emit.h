@@ -9,6 +9,7 @@
 #include "../core/bvh.h"
 #include "agglomerate.h"
 #include "level.h"
+#include "node_rules.h"
 
 namespace kmbvh {
 
@@ -24,20 +25,10 @@ struct AddChildCounts {
   }
 };
 
-struct EmitRules {
-  uint32_t max_leaf_size;  // m
-  uint32_t k;              // the build's k; small segments use 2
-  bool wide;
-
-  KMBVH_HD uint32_t child_k(uint32_t count) const {
-    return (k > 2 && count < max_leaf_size * k) ? 2u : k;
-  }
-};
-
 struct CountChildren {
   const Segment* segments;
   ClusterArrays clusters;
-  EmitRules rules;
+  NodeRules rules;
   ChildCounts* out;
 
   KMBVH_HD void operator()(uint32_t s) const {
@@ -115,7 +106,7 @@ template <uint32_t KMax>
 struct EmitChildren {
   const Segment* segments;
   ClusterArrays clusters;
-  EmitRules rules;
+  NodeRules rules;
   const ChildCounts* offsets;  // exclusive scan of CountChildren
   uint32_t node_base;          // nodes before this level's first new one
   BvhNode* nodes;

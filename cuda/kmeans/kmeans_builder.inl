@@ -29,6 +29,7 @@
 
 #include "../core/portable.h"
 #include "../core/breadth_first.h"
+#include "../core/parallel_errors.h"
 #include "agglomerate.h"
 #include "assign.h"
 #include "emit.h"
@@ -95,11 +96,11 @@ class KMeansLevels {
   }
 
  private:
-  EmitRules rules() const { return {params_.max_leaf_size, params_.k, params_.wide}; }
+  NodeRules rules() const { return node_rules(params_); }
 
   LevelView view() {
     return {ptr(boxes_[current_]), ptr(ids_[current_]), ptr(cluster_of_), ptr(segments_),
-            ptr(pieces_), ptr(piece_counters_), clusters()};
+            ptr(pieces_), ptr(piece_counters_), clusters(), rules().per_node_iterations()};
   }
   ClusterArrays clusters() {
     return {ptr(reps_), ptr(sums_), ptr(counts_), ptr(bounds_), ptr(cluster_begin_), ptr(cluster_segment_)};
@@ -109,7 +110,7 @@ class KMeansLevels {
   uint32_t split_level(uint32_t segment_count) {
     const uint32_t clusters = set_up(segment_count);
     for_each_index(segment_count, InitialiseSegment<M>{ptr(boxes_[current_]), ptr(segments_), ptr(reps_),
-                                                       params_.p, params_.seed});
+                                                       rules(), params_.seed});
     clock_.lap("initialise");
 
     for (uint32_t iteration = 0; iteration < params_.i; ++iteration) {
@@ -124,9 +125,10 @@ class KMeansLevels {
         for_each_index(piece_count_, AssignPiece<KMax, M, AssignPass::Final>{view()});
         clock_.lap("assign");
         partition(segment_count, /*gather_only=*/true);
-        for_each_index(clusters, UpdateMedians{ptr(boxes_[1 - current_]), this->clusters()});
+        for_each_index(clusters, UpdateMedians{ptr(boxes_[1 - current_]), ptr(segments_), this->clusters()});
         clock_.lap("update");
       }
+      if (rules().per_node_iterations() && all_stable(segment_count, iteration)) break;
     }
 
     clear_clusters(clusters, false);
@@ -164,6 +166,14 @@ class KMeansLevels {
                                                ptr(cluster_segment_)});
     clock_.lap("setup");
     return total.clusters;
+  }
+
+  // Marks the segments whose Lloyd loop is done (level.h: MarkStable); true when that is
+  // all of them. Stable segments keep their representatives: a mean update skips their
+  // pieces (AssignPiece), a median update their clusters (UpdateMedians).
+  bool all_stable(uint32_t segment_count, uint32_t iteration) {
+    for_each_index(segment_count, MarkStable{ptr(segments_), rules(), iteration});
+    return thrust::count_if(thrust::device, segments_.begin(), segments_.begin() + segment_count, IsUnstable{}) == 0;
   }
 
   void clear_clusters(uint32_t clusters, bool sums) {
@@ -225,13 +235,15 @@ class KMeansLevels {
     uint32_t* ids = ptr(ids_[current_]);
     uint32_t* final_ids = ptr(final_ids_);
     uint32_t forced = 0;
+    ParallelErrors errors;
 #pragma omp parallel reduction(+ : forced)
     {
       SubtreeSplitter<KMax, M> splitter(params_);
 #pragma omp for schedule(dynamic, 1)
       for (int64_t t = 0; t < int64_t(small.size()); ++t)
-        done[t] = splitter.split(small[t], boxes, ids, final_ids, forced);
+        errors.capture([&] { done[t] = splitter.split(small[t], boxes, ids, final_ids, forced); });
     }
+    errors.rethrow();
     for (SubtreeNodes& d : done) subtrees_.push_back(std::move(d));
     if (info_) info_->forced_splits += forced;
     clock_.lap("subtrees");

@@ -10,6 +10,7 @@
 
 #include "../core/aabb.h"
 #include "../core/atomics.h"
+#include "node_rules.h"
 
 namespace kmbvh {
 
@@ -22,6 +23,8 @@ struct Segment {
   uint32_t piece_base = 0;       // its pieces
   uint32_t piece_count = 0;
   uint32_t split_by_index = 0;   // 1 when clustering left fewer than two non-empty clusters
+  uint32_t changed = 0;          // assignments the current Lloyd iteration changed
+  uint32_t stable = 0;           // 1 once its Lloyd loop is done (MarkStable)
   Aabb box;                      // bounds of its primitives; the frame of the fixed-point sums
 };
 
@@ -77,6 +80,29 @@ struct LevelView {
   const Piece* pieces;
   uint32_t* piece_counters;
   ClusterArrays clusters;
+  bool per_node;         // NodeRules::per_node_iterations: count changes, sum passes skip stable segments
+};
+
+// After Lloyd iteration `iteration` of a level: a segment that has run its iterations
+// (NodeRules::iterations), or whose assignments changed little enough (NodeRules::settled,
+// with until_stable), is stable and iterates no more. The first iteration compares
+// against the previous level's leftovers, so its changes never count.
+struct MarkStable {
+  Segment* segments;
+  NodeRules rules;
+  uint32_t iteration;
+
+  KMBVH_HD void operator()(uint32_t s) const {
+    Segment& seg = segments[s];
+    if (iteration + 1 >= rules.iterations(seg.k) ||
+        (rules.until_stable && iteration > 0 && rules.settled(seg.changed, seg.count)))
+      seg.stable = 1;
+    seg.changed = 0;
+  }
+};
+
+struct IsUnstable {
+  KMBVH_HD bool operator()(const Segment& s) const { return s.stable == 0; }
 };
 
 }  // namespace kmbvh

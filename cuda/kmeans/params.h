@@ -20,6 +20,14 @@ struct KMeansParams {
   uint32_t seed = 1;
   ClusterMetric metric = ClusterMetric::Means;
   bool wide = false;           // emit the k-ary tree directly instead of binary treelets
+  // k, p and the number of Lloyd iterations chosen per node from its size, k, p and i
+  // above being the caps (node_rules.h).
+  bool adaptive = false;
+  // A node's Lloyd loop stops once an iteration changes at most settle_fraction of its
+  // assignments; i is the cap. With 0, that is a fixed point of the means, and the tree is
+  // the one i iterations would give.
+  bool until_stable = false;
+  float settle_fraction = 0.0f;
   // CPU backend: finish each node of at most one piece (2048 primitives) in one work item,
   // depth-first (subtree_cpu.h). The tree is the same either way; false runs every level
   // through the portable level loop, as the GPU does.
@@ -28,7 +36,10 @@ struct KMeansParams {
   static constexpr uint32_t kMaxK = 64;  // local arrays in the kernels are sized by this
 };
 
-// "Q1".."Q5" (case-insensitive), as in the paper's Table 1.
+// "Q1".."Q5" (case-insensitive), as in the paper's Table 1, and "QA", the adaptive preset:
+// k, p and the iteration cap per node (k up to 64, p up to 30, at most 15 iterations and
+// fewer for larger k), each node's Lloyd loop stopped once it moves at most 2% of its
+// primitives (node_rules.h).
 std::optional<KMeansParams> kmeans_preset(const std::string& name);
 const char* const* kmeans_preset_names();  // null-terminated list
 std::string to_string(ClusterMetric metric);

@@ -6,6 +6,7 @@
 
 #include "initialise.h"
 #include "level.h"
+#include "node_rules.h"
 
 namespace kmbvh {
 
@@ -45,6 +46,8 @@ struct SetupSegment {
     seg.piece_base = at.pieces;
     seg.piece_count = sizes.pieces(seg.count);
     seg.split_by_index = 0;
+    seg.changed = 0;
+    seg.stable = 0;
     for (uint32_t q = 0; q < seg.piece_count; ++q) {
       Piece& piece = pieces[seg.piece_base + q];
       piece.segment = s;
@@ -62,13 +65,13 @@ struct InitialiseSegment {
   const Aabb* boxes;
   const Segment* segments;
   Aabb* reps;
-  uint32_t p;
+  NodeRules rules;
   uint32_t seed;
 
   KMBVH_HD void operator()(uint32_t s) const {
     const Segment seg = segments[s];
-    initialise_representatives<M>(boxes + seg.begin, seg.count, seg.k, p, seed, node_stream(seg.begin, seg.count),
-                                  reps + seg.cluster_base);
+    initialise_representatives<M>(boxes + seg.begin, seg.count, seg.k, rules.candidates(seg.k), seed,
+                                  node_stream(seg.begin, seg.count), reps + seg.cluster_base);
   }
 };
 

@@ -66,9 +66,13 @@ class SubtreeSplitter {
   // Returns 1 when the node had to be split by position (the guaranteed split).
   uint32_t split_node(const Pending& p, Aabb* boxes, uint32_t* ids, uint32_t* final_ids, std::vector<BvhNode>& nodes) {
     const uint32_t k = p.k;
+    const NodeRules rules = node_rules(params_);
     Aabb reps[KMax];
-    initialise_representatives<M>(boxes, p.count, k, params_.p, params_.seed, node_stream(p.begin, p.count), reps);
-    for (uint32_t iteration = 0; iteration < params_.i; ++iteration) update(p, boxes, reps);
+    initialise_representatives<M>(boxes, p.count, k, rules.candidates(k), params_.seed, node_stream(p.begin, p.count),
+                                  reps);
+    // The first iteration compares with leftovers of another node, as the level loop's does.
+    for (uint32_t iteration = 0; iteration < rules.iterations(k); ++iteration)
+      if (rules.settled(update(p, boxes, reps), p.count) && iteration > 0 && rules.until_stable) break;
 
     // The final assignment, with the guaranteed split when it leaves one cluster.
     uint32_t count[KMax];
@@ -105,7 +109,6 @@ class SubtreeSplitter {
       box[j] = bounds[c];
       ++j;
     }
-    const EmitRules rules{params_.max_leaf_size, params_.k, params_.wide};
     const auto first_node = static_cast<uint32_t>(nodes.size());
     nodes.resize(nodes.size() + (rules.wide ? j : 2 * j - 2));
     lay_out_children<KMax>(nodes.data(), p.node, first_node, box, weight, j, rules.wide, [&](uint32_t t, uint32_t node) {
@@ -116,17 +119,21 @@ class SubtreeSplitter {
   }
 
   // One Lloyd iteration after an assignment: the mean (fixed point, as one piece of the
-  // level loop publishes it) or the component-wise median.
-  void update(const Pending& p, Aabb* boxes, Aabb* reps) {
+  // level loop publishes it) or the component-wise median. Returns how many assignments
+  // changed since the last iteration.
+  uint32_t update(const Pending& p, Aabb* boxes, Aabb* reps) {
     RepresentativeTable<KMax, M> table;
     table.load(reps, p.k);
     uint32_t count[KMax];
     for (uint32_t c = 0; c < p.k; ++c) count[c] = 0;
+    uint32_t changed = 0;
     if constexpr (M == ClusterMetric::Means) {
       SumAccumulator<KMax> acc;
       acc.clear(p.k);
       for (uint32_t x = 0; x < p.count; ++x) {
         const uint32_t c = table.nearest(boxes[x]);
+        changed += cluster_of_[x] != c;
+        cluster_of_[x] = static_cast<uint8_t>(c);
         ++count[c];
         acc.add(c, boxes[x]);
       }
@@ -143,6 +150,7 @@ class SubtreeSplitter {
     } else {
       for (uint32_t x = 0; x < p.count; ++x) {
         const uint32_t c = table.nearest(boxes[x]);
+        changed += cluster_of_[x] != c;
         cluster_of_[x] = static_cast<uint8_t>(c);
         ++count[c];
       }
@@ -158,6 +166,7 @@ class SubtreeSplitter {
         }
       }
     }
+    return changed;
   }
 
   void assign_final(const Aabb* boxes, uint32_t n, uint32_t k, const Aabb* reps, uint32_t* count, Aabb* bounds) {

@@ -56,13 +56,15 @@ KMBVH_HD inline float select_component(Aabb* boxes, uint32_t n, int d, uint32_t 
 }
 
 // Per cluster: the lower median (rank (n - 1) / 2) of each of the six components.
+// A stable segment (level.h) keeps its representatives.
 struct UpdateMedians {
   Aabb* gathered;  // the level's boxes, partitioned by cluster
+  const Segment* segments;
   ClusterArrays clusters;
 
   KMBVH_HD void operator()(uint32_t c) const {
     const uint32_t n = clusters.counts[c];
-    if (n == 0) return;
+    if (n == 0 || segments[clusters.segment[c]].stable) return;
     Aabb* members = gathered + clusters.begin[c];
     const uint32_t rank = (n - 1) / 2;
     Aabb rep;

@@ -42,6 +42,8 @@ class SweepBuilder {
     for (int a = 0; a < 3; ++a) right_area_[a].resize(n);
     side_.resize(n);
     for (int a = 0; a < 3; ++a) scratch_[a].resize(n);
+    // Every buffer is allocated here, outside the parallel regions, which must not throw.
+    for (int a = 0; a < 3; ++a) order_[a].resize(n);
   }
 
   Bvh build(BuildInfo* info) {
@@ -54,7 +56,6 @@ class SweepBuilder {
     };
 #pragma omp parallel for schedule(static, 1)
     for (int a = 0; a < 3; ++a) {
-      order_[a].resize(n);
       for (uint32_t i = 0; i < n; ++i) order_[a][i] = i;
       std::sort(order_[a].begin(), order_[a].end(), [&](uint32_t x, uint32_t y) {
         const float cx = centroid_[x][a], cy = centroid_[y][a];

@@ -2,6 +2,7 @@
 
 #include <omp.h>
 
+#include "../core/parallel_errors.h"
 #include "traverse_bvh2.h"
 
 namespace kmbvh {
@@ -25,12 +26,16 @@ void Bvh2OnGpu::trace(const Ray*, size_t, Query, Hit*) { require_backend(Backend
 namespace detail {
 
 void trace_bvh2_cpu(const Bvh2View& view, const Ray* rays, size_t n, Query query, Hit* hits) {
+  ParallelErrors errors;
 #pragma omp parallel
   {
-    std::vector<TraversalEntry> stack(view.stack_size);
+    std::vector<TraversalEntry> stack;
+    errors.capture([&] { stack.resize(view.stack_size); });
 #pragma omp for schedule(dynamic, 256)
-    for (size_t i = 0; i < n; ++i) trace_bvh2(view, rays[i], query, stack.data(), hits[i]);
+    for (size_t i = 0; i < n; ++i)
+      if (!errors.failed()) trace_bvh2(view, rays[i], query, stack.data(), hits[i]);
   }
+  errors.rethrow();
 }
 
 }  // namespace detail

@@ -65,6 +65,7 @@ KMBVH_HD KMBVH_INLINE bool trace_bvh2(const Bvh2View& view, const Ray& ray, Quer
       for (uint32_t i = cur.ref; i < cur.ref + cur.count; ++i) {
         const LeafTriangle& tri = view.triangles[i];
         if (!intersect_watertight(shear, ray.tnear, tmax, tri.a, tri.b, tri.c, hit)) continue;
+        if (!exact_t_within(ray, tri.a, tri.b, tri.c, ray.tnear, tmax)) continue;
         found = i;
         if (query == Query::Any) break;
         tmax = hit.t;

@@ -76,24 +76,51 @@ KMBVH_HD KMBVH_INLINE bool intersect_watertight(const RayShear& s, float tnear, 
   return true;
 }
 
-// The watertight test decides hit or miss, but its sheared, origin-relative coordinates
-// lose digits of t, u and v when the triangle is thin and seen almost edge-on from far
-// away (a wall across a room: u off by 1e-3 in float, by any float method; Embree's too).
-// So the closest hit, once known, is measured again from the triangle's own edges in
-// double precision: one more test per ray, and t, u, v correct to float precision.
-KMBVH_HD KMBVH_INLINE void refine_hit(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, Hit& hit) {
+// t, u, v of the ray's meeting with the triangle's plane from its own edges, in double
+// precision; false when the ray is parallel to the plane.
+KMBVH_HD KMBVH_INLINE bool exact_hit(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, double& t, double& u, double& v) {
   const double e1x = double(b.x) - a.x, e1y = double(b.y) - a.y, e1z = double(b.z) - a.z;
   const double e2x = double(c.x) - a.x, e2y = double(c.y) - a.y, e2z = double(c.z) - a.z;
   const double dx = ray.dir.x, dy = ray.dir.y, dz = ray.dir.z;
   const double px = dy * e2z - dz * e2y, py = dz * e2x - dx * e2z, pz = dx * e2y - dy * e2x;
   const double det = e1x * px + e1y * py + e1z * pz;
-  if (det == 0.0) return;
+  if (det == 0.0) return false;
   const double sx = double(ray.org.x) - a.x, sy = double(ray.org.y) - a.y, sz = double(ray.org.z) - a.z;
   const double qx = sy * e1z - sz * e1y, qy = sz * e1x - sx * e1z, qz = sx * e1y - sy * e1x;
   const double inv = 1.0 / det;
-  hit.u = float((sx * px + sy * py + sz * pz) * inv);
-  hit.v = float((dx * qx + dy * qy + dz * qz) * inv);
-  hit.t = float((e2x * qx + e2y * qy + e2z * qz) * inv);
+  u = (sx * px + sy * py + sz * pz) * inv;
+  v = (dx * qx + dy * qy + dz * qz) * inv;
+  t = (e2x * qx + e2y * qy + e2z * qz) * inv;
+  return true;
+}
+
+// Whether a hit the float test accepted lies in (tnear, tmax] by the exact distance too.
+// The float test decides on which side of each edge the ray passes (that keeps it
+// watertight), but on a needle triangle (nearly collinear vertices) the plane is so
+// ill-conditioned that its float t can land on the wrong side of the origin: a secondary
+// ray leaving a needle then hits the needle itself, behind it. Checked on accepted hits
+// only, a few per ray.
+KMBVH_HD KMBVH_INLINE bool exact_t_within(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, float tnear, float tmax) {
+  double t, u, v;
+  if (!exact_hit(ray, a, b, c, t, u, v)) return true;  // parallel in double: the float test decides
+  return t > double(tnear) && t <= double(tmax);
+}
+
+// The watertight test decides hit or miss, but its sheared, origin-relative coordinates
+// lose digits of t, u and v when the triangle is thin and seen almost edge-on from far
+// away (a wall across a room: u off by 1e-3 in float, by any float method; Embree's too).
+// So the closest hit, once known, is measured again from the triangle's own edges in
+// double precision: one more test per ray, and t, u, v and Ng correct to float precision.
+KMBVH_HD KMBVH_INLINE void refine_hit(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, Hit& hit) {
+  double t, u, v;
+  if (!exact_hit(ray, a, b, c, t, u, v)) return;
+  hit.u = float(u);
+  hit.v = float(v);
+  hit.t = float(t);
+  // The normal too: in float, the cross product of a needle's edges cancels catastrophically.
+  const double e1x = double(b.x) - a.x, e1y = double(b.y) - a.y, e1z = double(b.z) - a.z;
+  const double e2x = double(c.x) - a.x, e2y = double(c.y) - a.y, e2z = double(c.z) - a.z;
+  hit.Ng = Vec3(float(e1y * e2z - e1z * e2y), float(e1z * e2x - e1x * e2z), float(e1x * e2y - e1y * e2x));
 }
 
 }  // namespace kmbvh

@@ -18,7 +18,7 @@ void add_bench_command(CLI::App& app, BenchCommand& c) {
                   "scene files or names in $KMBVH_SCENES; 'default' is the embedded scene "
                   "(default: sponza_dabrovic sibenik conference)");
   cmd->add_option("--builders", c.builders,
-                  "comma-separated builders (sweep-sah, lbvh, hlbvh, atrbvh, ploc, Q1..Q5, embree-low|medium|high), "
+                  "comma-separated builders (sweep-sah, lbvh, hlbvh, atrbvh, ploc, Q1..Q5, QA, embree-low|medium|high), "
                   "or all");
   add_reference_options(*cmd, c.options);
   cmd->add_option("--reference", c.reference, "the builder build-time ratios are taken against");
@@ -28,20 +28,7 @@ void add_bench_command(CLI::App& app, BenchCommand& c) {
 
 int run_bench(const BenchCommand& c) {
   apply_run_options(c.run);
-  std::vector<BuilderConfig> configs;
-  for (const std::string& spec : split_list(c.builders)) {
-    if (spec == "all") {
-      for (const BuilderConfig& b : all_builders()) {
-        BuilderOptions options = c.options;
-        options.builder = b.builder == "kmeans" ? b.preset : b.builder;
-        configs.push_back(builder_config(options, c.run));
-      }
-      continue;
-    }
-    BuilderOptions options = c.options;
-    options.builder = spec;
-    configs.push_back(builder_config(options, c.run));
-  }
+  const std::vector<BuilderConfig> configs = builder_configs(c.builders, c.options, c.run);
 
   Progress progress(c.run.quiet);
   std::vector<std::vector<Measurement>> tables;

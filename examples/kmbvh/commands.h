@@ -31,6 +31,9 @@ struct BuilderOptions {
   uint32_t seed = 1;
   std::string metric = "means";
   bool wide = false;
+  bool adaptive = false, until_stable = false;
+  float settle = 0.0f;
+  CLI::Option *adaptive_opt = nullptr, *until_stable_opt = nullptr, *settle_opt = nullptr;
   BinaryBuildParams binary;  // ploc radius, treelet size and iterations
 };
 
@@ -61,12 +64,26 @@ struct TraceCommand {
   size_t show = 5;               // mismatching rays printed in full
 };
 
+// kmbvh stress [CASES...]: every builder on the generated stress cases (issue 7).
+struct StressCommand {
+  std::vector<std::string> cases;  // empty: all
+  std::string builders = "all";
+  uint32_t triangles = 50000;      // size of the cases that scale
+  uint32_t identical = 1000000;    // the identical-triangles case
+  size_t rays = 10000;             // of each kind
+  std::string markdown_path;       // also write the summary table here
+  BuilderOptions options;
+  RunOptions run;
+};
+
 void add_build_command(CLI::App& app, BuildCommand& command);
 void add_bench_command(CLI::App& app, BenchCommand& command);
 void add_trace_command(CLI::App& app, TraceCommand& command);
+void add_stress_command(CLI::App& app, StressCommand& command);
 
 int run_build(const BuildCommand& command);
 int run_bench(const BenchCommand& command);
+int run_stress(const StressCommand& command);
 int run_trace(const TraceCommand& command);
 
 }  // namespace kmbvh

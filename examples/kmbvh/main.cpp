@@ -1,9 +1,11 @@
 // kmbvh: build BVHs by k-means clustering (Meister and Bittner 2016) and compare them with
 // Embree's. `kmbvh build` runs one builder on one scene; `kmbvh bench` compares several;
-// `kmbvh trace` sends the same rays through kmbvh's traversal and Embree's.
+// `kmbvh trace` sends the same rays through kmbvh's traversal and Embree's; `kmbvh stress`
+// runs every builder on the inputs where builders fail.
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
+#include <new>
 #include <stdexcept>
 
 #include "adapters/in/triangle_scene.h"
@@ -16,9 +18,11 @@ int main(int argc, char** argv) {
   BuildCommand build;
   BenchCommand bench;
   TraceCommand trace;
+  StressCommand stress;
   add_build_command(app, build);
   add_bench_command(app, bench);
   add_trace_command(app, trace);
+  add_stress_command(app, stress);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -29,6 +33,7 @@ int main(int argc, char** argv) {
   try {
     if (app.got_subcommand("build")) return run_build(build);
     if (app.got_subcommand("trace")) return run_trace(trace);
+    if (app.got_subcommand("stress")) return run_stress(stress);
     return run_bench(bench);
   } catch (const SceneError& e) {
     fmt::print(stderr, "kmbvh: error: {}\n", e.what());
@@ -36,6 +41,9 @@ int main(int argc, char** argv) {
   } catch (const std::invalid_argument& e) {
     fmt::print(stderr, "kmbvh: error: {}\n", e.what());
     return kExitBadInput;
+  } catch (const std::bad_alloc&) {
+    fmt::print(stderr, "kmbvh: error: out of memory\n");
+    return kExitBuildFailed;
   } catch (const std::exception& e) {
     fmt::print(stderr, "kmbvh: build failed: {}\n", e.what());
     return kExitBuildFailed;

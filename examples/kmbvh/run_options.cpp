@@ -22,8 +22,8 @@ void add_run_options(CLI::App& cmd, RunOptions& run) {
 
 void add_builder_options(CLI::App& cmd, BuilderOptions& b) {
   cmd.add_option("--builder", b.builder,
-                  "sweep-sah, lbvh, hlbvh, atrbvh, ploc, kmeans (or Q1..Q5), embree-low, embree-medium, embree-high");
-  cmd.add_option("--preset", b.preset, "k-means preset Q1..Q5 (the paper's)");
+                  "sweep-sah, lbvh, hlbvh, atrbvh, ploc, kmeans (or Q1..Q5, QA), embree-low, embree-medium, embree-high");
+  cmd.add_option("--preset", b.preset, "k-means preset Q1..Q5 (the paper's) or QA (adaptive)");
   b.k_opt = cmd.add_option("--k", b.k, "k-means: clusters per node (2..64)");
   b.p_opt = cmd.add_option("--p", b.p, "k-means: candidates per representative");
   b.i_opt = cmd.add_option("--i", b.i, "k-means: Lloyd iterations (0 allowed)");
@@ -31,6 +31,13 @@ void add_builder_options(CLI::App& cmd, BuilderOptions& b) {
   cmd.add_option("--seed", b.seed, "k-means: seed of the counter-based random draws");
   cmd.add_option("--metric", b.metric, "k-means: means or medians")->check(CLI::IsMember({"means", "medians"}));
   cmd.add_flag("--wide", b.wide, "k-means: emit the k-ary tree itself instead of binary treelets");
+  b.adaptive_opt = cmd.add_flag("--adaptive", b.adaptive, "k-means: k and p per node from its size (--k, --p are caps)");
+  b.until_stable_opt =
+      cmd.add_flag("--until-stable", b.until_stable, "k-means: stop a node's Lloyd loop once no assignment changes");
+  b.settle_opt = cmd.add_option("--settle", b.settle,
+                                "k-means with --until-stable: the fraction of a node's assignments an iteration may "
+                                "change and still end the loop (0: none)")
+                     ->check(CLI::Range(0.0f, 1.0f));
   add_reference_options(cmd, b);
 }
 
@@ -58,9 +65,13 @@ BuilderConfig builder_config(const BuilderOptions& o, const RunOptions& run) {
   config.backend = backend_of(run);
   config.binary = o.binary;
   if (config.builder == "kmeans") {
-    const bool custom =
-        (o.k_opt && o.k_opt->count()) || (o.p_opt && o.p_opt->count()) || (o.i_opt && o.i_opt->count());
+    const auto given = [](const CLI::Option* opt) { return opt && opt->count() > 0; };
+    const bool custom = given(o.k_opt) || given(o.p_opt) || given(o.i_opt) || given(o.adaptive_opt) ||
+                        given(o.until_stable_opt) || given(o.settle_opt);
     if (custom) config.preset.clear();
+    if (given(o.adaptive_opt)) config.kmeans.adaptive = o.adaptive;
+    if (given(o.until_stable_opt)) config.kmeans.until_stable = o.until_stable;
+    if (given(o.settle_opt)) config.kmeans.settle_fraction = o.settle;
     if (o.k_opt && o.k_opt->count()) config.kmeans.k = o.k;
     if (o.p_opt && o.p_opt->count()) config.kmeans.p = o.p;
     if (o.i_opt && o.i_opt->count()) config.kmeans.i = o.i;
@@ -72,6 +83,25 @@ BuilderConfig builder_config(const BuilderOptions& o, const RunOptions& run) {
   }
   check_config(config);
   return config;
+}
+
+std::vector<BuilderConfig> builder_configs(const std::string& list, const BuilderOptions& options,
+                                           const RunOptions& run) {
+  std::vector<BuilderConfig> configs;
+  auto add = [&](const std::string& spec) {
+    BuilderOptions o = options;
+    o.builder = spec;
+    configs.push_back(builder_config(o, run));
+  };
+  for (const std::string& spec : split_list(list)) {
+    if (spec != "all") {
+      add(spec);
+      continue;
+    }
+    for (const BuilderConfig& b : all_builders()) add(b.builder == "kmeans" ? b.preset : b.builder);
+  }
+  if (configs.empty()) throw std::invalid_argument("--builders: no builder given");
+  return configs;
 }
 
 }  // namespace kmbvh

@@ -1,24 +1,21 @@
-// Scenes made in code for tests: random triangle soups and the degenerate cases every
-// builder must survive.
+// The scenes of the tests: the shared scene folder's files, and the generated scenes.
 #pragma once
 
 #include <cstdint>
 #include <string>
 #include <vector>
 
-#include "adapters/in/triangle_scene.h"
+#include "adapters/in/generated_scenes.h"
 
 namespace kmbvh::test {
 
-// n triangles of random size and shape in a cube, some large and some tiny.
-TriangleScene random_triangles(uint32_t n, uint32_t seed);
-
-// Clustered: dense balls of small triangles with empty space between them.
-TriangleScene clustered_triangles(uint32_t n, uint32_t seed);
-
-TriangleScene identical_triangles(uint32_t n);           // every triangle the same
-TriangleScene shared_centroid_triangles(uint32_t n);      // nested, all centred on one point
-TriangleScene zero_area_triangles(uint32_t n, uint32_t seed);  // collinear or repeated vertices
+// The generated scenes live with the adapters (kmbvh stress uses them too).
+using kmbvh::clustered_triangles;
+using kmbvh::identical_triangles;
+using kmbvh::random_triangles;
+using kmbvh::random_unit;
+using kmbvh::shared_centroid_triangles;
+using kmbvh::zero_area_triangles;
 
 // The glTF and OBJ files of the shared scene folder ($KMBVH_SCENES), sorted; empty when
 // the folder is absent.
@@ -26,7 +23,5 @@ std::vector<std::string> scene_files();
 
 // A builder spec ("Q2+wide4") as a GoogleTest parameter name ("Q2_wide4").
 std::string test_name(const std::string& spec);
-
-float random_unit(uint32_t seed, uint32_t stream, uint32_t index);  // uniform in [0, 1)
 
 }  // namespace kmbvh::test
