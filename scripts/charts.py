@@ -4,11 +4,13 @@
   scripts/charts.py stress STRESS.json OUT_DIR   # "where methods fail": cases x builders
   scripts/charts.py presets BENCH.json OUT_DIR   # k-means presets: build time against SAH cost
   scripts/charts.py table BENCH.json OUT.md      # the adaptive preset against the best fixed one
+  scripts/charts.py scaling BENCH.json OUT_DIR   # build time and memory against triangles, log-log
 
 Each chart is written as PNG and SVG. STRESS.json is `kmbvh stress --json`; BENCH.json is
 `kmbvh bench --json` with the k-means presets among its builders.
 """
 import json
+import math
 import sys
 from pathlib import Path
 
@@ -120,8 +122,52 @@ def presets_table(rows, out_path):
     Path(out_path).write_text("\n".join(lines) + "\n")
 
 
+def scaling_chart(rows, out_dir):
+    """Build time and peak memory per triangle against triangle count, one line per builder,
+    log-log, with n log n through each builder's smallest scene for reference; and a table
+    (scaling.md) of each builder's time over n log2 n, relative to its smallest scene."""
+    builders = ordered(r["builder"] for r in rows)
+    fig, (time_ax, memory_ax) = plt.subplots(1, 2, figsize=(12, 4.5))
+    lines = ["| builder | " + " | ".join(f"{n:,}" for n in sorted({r['triangles'] for r in rows})) +
+             " | time / (n log n), largest over smallest |",
+             "|---|" + "---:|" * (len({r['triangles'] for r in rows}) + 1)]
+    for b in builders:
+        mine = sorted((r for r in rows if r["builder"] == b), key=lambda r: r["triangles"])
+        n = [r["triangles"] for r in mine]
+        ms = [r["build_ms"] for r in mine]
+        (line,) = time_ax.plot(n, ms, marker="o", label=b.replace("kmeans ", ""))
+        memory_ax.plot(n, [r["build_bytes_per_triangle"] for r in mine], marker="o", color=line.get_color(),
+                       label=b.replace("kmeans ", ""))
+        per = [t / (k * math.log2(k)) for t, k in zip(ms, n)]
+        growth = per[-1] / per[0] if per and per[0] > 0 else float("nan")
+        by_n = {r["triangles"]: r["build_ms"] for r in mine}
+        cells = " | ".join(f"{by_n[k]:.0f}" if k in by_n else "" for k in sorted({r['triangles'] for r in rows}))
+        lines.append(f"| {b} | {cells} | {growth:.2f} |")
+    n_all = sorted({r["triangles"] for r in rows})
+    time_ax.set(xscale="log", yscale="log", xlabel="triangles", ylabel="build ms (median)",
+                title="Build time against scene size")
+    memory_ax.set(xscale="log", xlabel="triangles", ylabel="peak bytes per triangle beyond the input",
+                  title="Build memory per triangle")
+    memory_ax.axhline(100, color="grey", linestyle="--", linewidth=1)
+    for ax in (time_ax, memory_ax):
+        ax.grid(True, which="both", alpha=0.3)
+    time_ax.legend(fontsize=8)
+    if len(n_all) > 1:  # n log n, scaled to pass through the median builder's smallest time
+        smallest = sorted(r["build_ms"] for r in rows if r["triangles"] == n_all[0])
+        t0 = smallest[len(smallest) // 2]
+        time_ax.plot(n_all, [t0 * k * math.log2(k) / (n_all[0] * math.log2(n_all[0])) for k in n_all],
+                     color="grey", linestyle="--", linewidth=1, label="n log n")
+        time_ax.legend(fontsize=8)
+    fig.tight_layout()
+    save(fig, out_dir, "scaling")
+    lines.append("")
+    lines.append("Time over n log2 n at the largest scene divided by the same at the smallest: "
+                 "1 or less means growing no faster than n log n.")
+    (Path(out_dir) / "scaling.md").write_text("\n".join(lines) + "\n")
+
+
 def main(argv):
-    if len(argv) != 4 or argv[1] not in ("stress", "presets", "table"):
+    if len(argv) != 4 or argv[1] not in ("stress", "presets", "table", "scaling"):
         sys.exit(__doc__)
     path = Path(argv[2])
     try:
@@ -130,7 +176,8 @@ def main(argv):
         sys.exit(f"charts.py: {path}: {e}")
     if not rows:
         sys.exit(f"charts.py: {path}: no rows")
-    {"stress": stress_chart, "presets": presets_chart, "table": presets_table}[argv[1]](rows, Path(argv[3]))
+    charts = {"stress": stress_chart, "presets": presets_chart, "table": presets_table, "scaling": scaling_chart}
+    charts[argv[1]](rows, Path(argv[3]))
 
 
 if __name__ == "__main__":

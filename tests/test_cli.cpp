@@ -177,3 +177,13 @@ TEST(Cli, StressRejectsAnUnknownCase) {
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("unknown stress case 'no-such-case'"), std::string::npos) << r.err;
 }
+
+TEST(Cli, InstancedSceneFromAName) {
+  const Result r = run("build " + small_obj().string() + "@9 --builder Q1 --runs 1 --json -q");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const Result one = run("build " + small_obj().string() + " --builder Q1 --runs 1 --json -q");
+  ASSERT_EQ(one.exit_code, 0) << one.err;
+  EXPECT_EQ(nlohmann::json::parse(r.out)["triangles"].get<size_t>(),
+            9 * nlohmann::json::parse(one.out)["triangles"].get<size_t>());
+  EXPECT_EQ(run("build " + small_obj().string() + "@0 -q").exit_code, 2);
+}

@@ -8,6 +8,7 @@
 #include <fstream>
 
 #include "adapters/in/default_scene.h"
+#include "adapters/in/instanced_scene.h"
 #include "adapters/in/load_scene.h"
 #include "support/printers.h"
 #include "support/temp_files.h"
@@ -286,6 +287,46 @@ TEST(BadFiles, EveryOneIsAOneLineErrorNamingTheFileAndTheProblem) {
     EXPECT_NE(error.find(f.expected), std::string::npos) << f.name << ": " << error;
     EXPECT_EQ(error.find('\n'), std::string::npos) << f.name << ": one line: " << error;
   }
+}
+
+}  // namespace
+}  // namespace kmbvh
+
+namespace kmbvh {
+namespace {
+
+TEST(InstancedScene, CopiesOnAGridOverTheTwoWidestAxes) {
+  TriangleScene mesh;
+  mesh.name = "pair";
+  mesh.add_triangle(Vec3(0, 0, 0), Vec3(10, 0, 0), Vec3(0, 0, 4));
+  mesh.add_triangle(Vec3(10, 0, 4), Vec3(10, 1, 0), Vec3(0, 0, 4));
+  const TriangleScene grid = instanced_grid(mesh, 5);  // 3 columns, 2 rows
+  EXPECT_EQ(grid.name, "pair@5");
+  ASSERT_EQ(grid.size(), 10u);
+  ASSERT_EQ(grid.positions.size(), mesh.positions.size() * 5);
+  // x (10 wide) and z (4 deep) are the widest axes: copies step 11 along x and 4.4 along z.
+  const Aabb b = grid.bounds();
+  EXPECT_FLOAT_EQ(b.hi.x, 2 * 11.0f + 10.0f);
+  EXPECT_FLOAT_EQ(b.hi.z, 4.4f + 4.0f);
+  EXPECT_FLOAT_EQ(b.hi.y, 1.0f);
+  for (const Triangle& t : grid.triangles)
+    for (uint32_t v : t) EXPECT_LT(v, grid.positions.size());
+}
+
+TEST(InstancedScene, NamesAndBadCounts) {
+  const auto conference = parse_instanced_name("conference@36");
+  ASSERT_TRUE(conference.has_value());
+  EXPECT_EQ(conference->base, "conference");
+  EXPECT_EQ(conference->copies, 36u);
+  EXPECT_FALSE(parse_instanced_name("conference").has_value());
+  EXPECT_FALSE(parse_instanced_name("/scenes/wall@2x.obj").has_value());  // a file name
+  EXPECT_THROW(parse_instanced_name("conference@0"), SceneError);
+  EXPECT_THROW(parse_instanced_name("conference@100000"), SceneError);
+  TriangleScene big;
+  big.name = "big";
+  big.positions = {Vec3(0.0f), Vec3(1, 0, 0), Vec3(0, 1, 0)};
+  big.triangles.assign(1 << 17, Triangle{0, 1, 2});
+  EXPECT_THROW(instanced_grid(big, 4096), SceneError);  // 2^29 triangles
 }
 
 }  // namespace

@@ -6,6 +6,7 @@
 #include <chrono>
 
 #include "adapters/in/default_scene.h"
+#include "adapters/in/instanced_scene.h"
 #include "adapters/in/load_scene.h"
 #include "adapters/in/scene_folder.h"
 #include "cuda/core/threads.h"
@@ -21,17 +22,23 @@ double median(std::vector<double> v) {
   return v.size() % 2 ? v[h] : 0.5 * (v[h - 1] + v[h]);
 }
 
+namespace {
+
+TriangleScene read_scene(const std::string& argument) {
+  if (argument.empty() || argument == "default") return make_default_scene();
+  const auto path = find_scene_file(argument);
+  if (!path)
+    throw SceneError(fmt::format("{}: no such file (nor a scene of that name in {})", argument, scene_folder()));
+  return load_scene_file(*path);
+}
+
+}  // namespace
+
 LoadedScene load_scene_argument(const std::string& argument) {
   const auto start = std::chrono::steady_clock::now();
-  TriangleScene scene;
-  if (argument.empty() || argument == "default") {
-    scene = make_default_scene();
-  } else {
-    const auto path = find_scene_file(argument);
-    if (!path)
-      throw SceneError(fmt::format("{}: no such file (nor a scene of that name in {})", argument, scene_folder()));
-    scene = load_scene_file(*path);
-  }
+  const auto instanced = parse_instanced_name(argument);
+  TriangleScene scene =
+      instanced ? instanced_grid(read_scene(instanced->base), instanced->copies) : read_scene(argument);
   LoadedScene loaded;
   loaded.name = scene.name;
   loaded.triangles = scene.size();

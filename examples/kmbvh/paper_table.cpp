@@ -28,6 +28,7 @@ const std::map<std::string, Row>& table() {
 }  // namespace
 
 std::optional<PaperFigures> paper_figures(const std::string& scene, const std::string& column) {
+  if (scene.find('@') != std::string::npos) return std::nullopt;  // copies (instanced_scene.h): not the paper's scene
   const std::string stem = scene.substr(0, scene.find('.'));
   const auto row = table().find(stem);
   if (row == table().end()) return std::nullopt;
