@@ -26,6 +26,11 @@ bool is_embree(const std::string& name, EmbreeQuality* quality) {
 
 }  // namespace
 
+bool is_embree_builder(const std::string& name) {
+  EmbreeQuality quality;
+  return is_embree(name, &quality);
+}
+
 std::string BuilderConfig::label() const {
   const BinaryBuildParams defaults;
   if (builder == "ploc" && binary.ploc_radius != defaults.ploc_radius)

@@ -29,6 +29,9 @@ struct BuilderConfig {
 
 const std::vector<std::string>& builder_names();
 
+// embree-low, embree-medium, embree-high: Embree's own builders, not kmbvh's.
+bool is_embree_builder(const std::string& name);
+
 // "kmeans" with the preset, "kmeans:Q3", "Q3" (shorthand), or any other builder name.
 // Throws std::invalid_argument naming what is unknown.
 BuilderConfig parse_builder(const std::string& spec);

@@ -23,7 +23,6 @@ constexpr int kModeTriangles = 4, kModeStrip = 5, kModeFan = 6;
 constexpr int kMaxNodeDepth = 512;
 // Bounds on what flattening may make, checked before anything is read (count_flattened).
 constexpr uint64_t kMaxNodeInstances = uint64_t(1) << 24;
-constexpr uint64_t kMaxTriangles = uint64_t(1) << 28;
 
 uint64_t saturating_add(uint64_t a, uint64_t b) { return a > ~uint64_t(0) - b ? ~uint64_t(0) : a + b; }
 
@@ -116,8 +115,8 @@ class GltfReader {
     if (total.instances > kMaxNodeInstances)
       fail(fmt::format("the node hierarchy makes {} node instances, more than {} (a node reused under too many "
                        "parents)", total.instances, kMaxNodeInstances));
-    if (total.triangles > kMaxTriangles)
-      fail(fmt::format("the scene flattens to {} triangles, more than {}", total.triangles, kMaxTriangles));
+    if (total.triangles > kMaxSceneTriangles)
+      fail(fmt::format("the scene flattens to {} triangles, more than {}", total.triangles, kMaxSceneTriangles));
   }
 
   Flattened count_under(int index, std::vector<Flattened>& memo, std::vector<uint8_t>& state, int depth) const {

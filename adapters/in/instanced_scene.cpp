@@ -8,10 +8,9 @@
 namespace kmbvh {
 
 TriangleScene instanced_grid(const TriangleScene& mesh, uint32_t copies) {
-  constexpr uint64_t kMaxTriangles = uint64_t(1) << 28;  // as the glTF loader's bound
-  if (uint64_t(mesh.size()) * copies > kMaxTriangles)
+  if (uint64_t(mesh.size()) * copies > kMaxSceneTriangles)
     throw SceneError(fmt::format("{}@{}: {} copies of {} triangles are more than {}", mesh.name, copies, copies,
-                                 mesh.size(), kMaxTriangles));
+                                 mesh.size(), kMaxSceneTriangles));
   const Aabb box = mesh.bounds();
   const Vec3 extent = mesh.size() ? box.extent() : Vec3(0.0f);
   // The grid spans the two widest axes.

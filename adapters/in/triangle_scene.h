@@ -15,6 +15,10 @@ namespace kmbvh {
 
 using Triangle = std::array<uint32_t, 3>;
 
+// The most triangles (and vertices) a scene made by flattening may have: instancing in a
+// glTF node graph or NAME@N copies are refused beyond it, before anything is allocated.
+constexpr uint64_t kMaxSceneTriangles = uint64_t(1) << 28;
+
 struct TriangleScene {
   std::string name;                   // the file's name, or "default"
   std::vector<Vec3> positions;

@@ -76,21 +76,34 @@ KMBVH_HD KMBVH_INLINE bool intersect_watertight(const RayShear& s, float tnear, 
   return true;
 }
 
+// A triangle's edges from its first vertex, in double precision (exact: each is the
+// difference of two floats).
+struct ExactEdges {
+  double e1x, e1y, e1z, e2x, e2y, e2z;
+
+  KMBVH_HD explicit ExactEdges(Vec3 a, Vec3 b, Vec3 c)
+      : e1x(double(b.x) - a.x), e1y(double(b.y) - a.y), e1z(double(b.z) - a.z),
+        e2x(double(c.x) - a.x), e2y(double(c.y) - a.y), e2z(double(c.z) - a.z) {}
+
+  // The unnormalised geometric normal e1 x e2, rounded once.
+  KMBVH_HD Vec3 normal() const {
+    return Vec3(float(e1y * e2z - e1z * e2y), float(e1z * e2x - e1x * e2z), float(e1x * e2y - e1y * e2x));
+  }
+};
+
 // t, u, v of the ray's meeting with the triangle's plane from its own edges, in double
 // precision; false when the ray is parallel to the plane.
-KMBVH_HD KMBVH_INLINE bool exact_hit(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, double& t, double& u, double& v) {
-  const double e1x = double(b.x) - a.x, e1y = double(b.y) - a.y, e1z = double(b.z) - a.z;
-  const double e2x = double(c.x) - a.x, e2y = double(c.y) - a.y, e2z = double(c.z) - a.z;
+KMBVH_HD KMBVH_INLINE bool exact_hit(const Ray& ray, Vec3 a, const ExactEdges& e, double& t, double& u, double& v) {
   const double dx = ray.dir.x, dy = ray.dir.y, dz = ray.dir.z;
-  const double px = dy * e2z - dz * e2y, py = dz * e2x - dx * e2z, pz = dx * e2y - dy * e2x;
-  const double det = e1x * px + e1y * py + e1z * pz;
+  const double px = dy * e.e2z - dz * e.e2y, py = dz * e.e2x - dx * e.e2z, pz = dx * e.e2y - dy * e.e2x;
+  const double det = e.e1x * px + e.e1y * py + e.e1z * pz;
   if (det == 0.0) return false;
   const double sx = double(ray.org.x) - a.x, sy = double(ray.org.y) - a.y, sz = double(ray.org.z) - a.z;
-  const double qx = sy * e1z - sz * e1y, qy = sz * e1x - sx * e1z, qz = sx * e1y - sy * e1x;
+  const double qx = sy * e.e1z - sz * e.e1y, qy = sz * e.e1x - sx * e.e1z, qz = sx * e.e1y - sy * e.e1x;
   const double inv = 1.0 / det;
   u = (sx * px + sy * py + sz * pz) * inv;
   v = (dx * qx + dy * qy + dz * qz) * inv;
-  t = (e2x * qx + e2y * qy + e2z * qz) * inv;
+  t = (e.e2x * qx + e.e2y * qy + e.e2z * qz) * inv;
   return true;
 }
 
@@ -102,7 +115,7 @@ KMBVH_HD KMBVH_INLINE bool exact_hit(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, dou
 // only, a few per ray.
 KMBVH_HD KMBVH_INLINE bool exact_t_within(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, float tnear, float tmax) {
   double t, u, v;
-  if (!exact_hit(ray, a, b, c, t, u, v)) return true;  // parallel in double: the float test decides
+  if (!exact_hit(ray, a, ExactEdges(a, b, c), t, u, v)) return true;  // parallel in double: the float test decides
   return t > double(tnear) && t <= double(tmax);
 }
 
@@ -112,15 +125,14 @@ KMBVH_HD KMBVH_INLINE bool exact_t_within(const Ray& ray, Vec3 a, Vec3 b, Vec3 c
 // So the closest hit, once known, is measured again from the triangle's own edges in
 // double precision: one more test per ray, and t, u, v and Ng correct to float precision.
 KMBVH_HD KMBVH_INLINE void refine_hit(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, Hit& hit) {
+  const ExactEdges edges(a, b, c);
   double t, u, v;
-  if (!exact_hit(ray, a, b, c, t, u, v)) return;
+  if (!exact_hit(ray, a, edges, t, u, v)) return;
   hit.u = float(u);
   hit.v = float(v);
   hit.t = float(t);
   // The normal too: in float, the cross product of a needle's edges cancels catastrophically.
-  const double e1x = double(b.x) - a.x, e1y = double(b.y) - a.y, e1z = double(b.z) - a.z;
-  const double e2x = double(c.x) - a.x, e2y = double(c.y) - a.y, e2z = double(c.z) - a.z;
-  hit.Ng = Vec3(float(e1y * e2z - e1z * e2y), float(e1z * e2x - e1x * e2z), float(e1x * e2y - e1y * e2x));
+  hit.Ng = edges.normal();
 }
 
 }  // namespace kmbvh

@@ -78,7 +78,7 @@ StressRow run_one(const StressCase& c, const PrimitiveSet& prims, size_t dropped
   row.triangles = c.scene.size();
   row.dropped = dropped;
   row.builder = config.label();
-  row.kmbvh = config.builder.rfind("embree", 0) != 0;  // embree-low, -medium, -high
+  row.kmbvh = !is_embree_builder(config.builder);
   try {
     prepare_builder(config);
     const auto start = std::chrono::steady_clock::now();

@@ -4,6 +4,7 @@
 // failure of Embree's own builders is reported but is not kmbvh's.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
@@ -85,7 +86,10 @@ int run_stress(const StressCommand& c) {
   apply_run_options(c.run);
   const std::vector<BuilderConfig> configs = builder_configs(c.builders, c.options, c.run);
   const std::vector<std::string> names = c.cases.empty() ? stress_case_names() : c.cases;
-  for (const std::string& name : names) make_stress_case(name, StressSizes{1, 1});  // unknown names fail first
+  const std::vector<std::string> known = stress_case_names();
+  for (const std::string& name : names)  // unknown names fail before any work
+    if (std::find(known.begin(), known.end(), name) == known.end())
+      throw std::invalid_argument(fmt::format("unknown stress case '{}'", name));
 
   Progress progress(c.run.quiet);
   StressOptions options;
