@@ -1,5 +1,7 @@
-# The charts of the results page from a small run: `kmbvh stress` and `kmbvh bench` JSON
-# through scripts/charts.py; every chart (PNG and SVG) and the table must come out non-trivial.
+# The charts of the results page from a small run: `kmbvh stress`, `kmbvh bench` and its
+# suites' JSON (names as scripts/results.sh writes them) through scripts/charts.py, once
+# chart by chart and once with `charts.py all`; every chart (PNG and SVG) and table must
+# come out non-trivial.
 # -DKMBVH=<kmbvh> -DPYTHON=<python3> -DCHARTS=<charts.py> -DOUT=<folder>
 file(REMOVE_RECURSE "${OUT}")
 file(MAKE_DIRECTORY "${OUT}")
@@ -12,11 +14,21 @@ endfunction()
 run(${KMBVH} stress one needles grid --triangles 300 --rays 50 --builders sweep-sah,Q2,QA,embree-medium --json -q
     OUTPUT_FILE "${OUT}/stress.json")
 run(${KMBVH} bench default --builders Q1,Q3,QA --runs 1 --warmup 0 --json -q OUTPUT_FILE "${OUT}/presets.json")
+run(${KMBVH} bench --suite paper default --builders sweep-sah,lbvh,Q1,QA,embree-medium,embree-scene --width 48
+    --height 36 --spp-lq 1 --spp-hq 2 --views 0,1 --runs 1 --warmup 0 --json -q OUTPUT_FILE "${OUT}/suite.json")
+run(${KMBVH} bench --suite iterations default --ks 8,16 --iterations 0,1,3 --runs 1 --warmup 0 --json -q
+    OUTPUT_FILE "${OUT}/iterations.json")
+run(${KMBVH} bench default --builders Q1,Q2,QA --level-loop --runs 1 --warmup 0 --json -q OUTPUT_FILE "${OUT}/phases.json")
 run(${PYTHON} ${CHARTS} stress "${OUT}/stress.json" "${OUT}")
 run(${PYTHON} ${CHARTS} presets "${OUT}/presets.json" "${OUT}")
 run(${PYTHON} ${CHARTS} table "${OUT}/presets.json" "${OUT}/presets.md")
 run(${PYTHON} ${CHARTS} scaling "${OUT}/presets.json" "${OUT}")
-foreach(f stress.png stress.svg presets.png presets.svg presets.md scaling.png scaling.svg scaling.md)
+run(${PYTHON} ${CHARTS} pareto "${OUT}/suite.json" "${OUT}")
+set(charts stress presets scaling pareto)
+foreach(f ${charts})
+  list(APPEND files ${f}.png ${f}.svg)
+endforeach()
+foreach(f ${files} presets.md scaling.md)
   if(NOT EXISTS "${OUT}/${f}")
     message(FATAL_ERROR "charts: ${f} was not written")
   endif()
@@ -28,4 +40,20 @@ endforeach()
 file(READ "${OUT}/presets.md" table)
 if(NOT table MATCHES "\\| default \\| 235,878 \\|")
   message(FATAL_ERROR "charts: the table has no row for the default scene:\n${table}")
+endif()
+
+# Everything at once, from the folder's JSON.
+file(REMOVE "${OUT}/pareto.png" "${OUT}/presets.md")
+run(${PYTHON} ${CHARTS} all "${OUT}")
+foreach(f pareto speed time_to_image iterations phases stress presets scaling)
+  foreach(ext png svg)
+    file(SIZE "${OUT}/${f}.${ext}" size)
+    if(size LESS 2000)
+      message(FATAL_ERROR "charts all: ${f}.${ext} has only ${size} bytes")
+    endif()
+  endforeach()
+endforeach()
+file(READ "${OUT}/targets.md" targets)
+if(NOT targets MATCHES "\\| default \\|" OR NOT targets MATCHES "Pareto front on [01] of 1 scenes")
+  message(FATAL_ERROR "charts: the targets table is not what the suite's rows give:\n${targets}")
 endif()

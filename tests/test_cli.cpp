@@ -187,3 +187,114 @@ TEST(Cli, InstancedSceneFromAName) {
             9 * nlohmann::json::parse(one.out)["triangles"].get<size_t>());
   EXPECT_EQ(run("build " + small_obj().string() + "@0 -q").exit_code, 2);
 }
+
+namespace {
+
+TEST(Cli, RenderWritesPngAndExrOfEachViewAndTimesIt) {
+  const fs::path out = kmbvh::test::temp_path("render-out");
+  for (const std::string& system : {std::string("--builder Q2 --layout bvh4"), std::string("--traversal embree")}) {
+    const Result r = run("render " + small_obj().string() + " " + system + " --width 64 --height 48 --spp 2 --views 0,2 "
+                         "--threads 2 --out " + out.string() + " --json -q");
+    ASSERT_EQ(r.exit_code, 0) << system << ": " << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    for (const char* field : {"scene", "triangles", "scene_kind", "views_from", "system", "traversal", "layout", "threads",
+                              "width", "height", "spp", "build_ms", "layout_ms", "mean_render_ms", "time_to_image_ms",
+                              "valid", "views"})
+      EXPECT_TRUE(j.contains(field)) << field;
+    EXPECT_EQ(j["spp"], 2);
+    ASSERT_EQ(j["views"].size(), 2u);
+    EXPECT_EQ(j["views"][1]["view"], 2);
+    for (const auto& view : j["views"]) {
+      EXPECT_GT(view["rays"].get<uint64_t>(), 64u * 48u);
+      EXPECT_GT(view["render_ms"].get<double>(), 0.0);
+      for (const char* file : {"png", "exr"}) {
+        const fs::path path = view[file].get<std::string>();
+        EXPECT_TRUE(fs::exists(path)) << path;
+        EXPECT_GT(fs::file_size(path), 100u) << path;
+      }
+    }
+    EXPECT_NEAR(j["time_to_image_ms"].get<double>(),
+                j["build_ms"].get<double>() + j["layout_ms"].get<double>() + j["mean_render_ms"].get<double>(), 1e-6);
+  }
+}
+
+TEST(Cli, RenderRejectsAViewTheSceneDoesNotHave) {
+  const Result r = run("render " + small_obj().string() + " --views 7 --width 8 --height 8 -q --out " +
+                       kmbvh::test::temp_path("render-bad").string());
+  EXPECT_EQ(r.exit_code, 2);
+  EXPECT_NE(r.err.find("--views: '7'"), std::string::npos) << r.err;
+}
+
+TEST(Cli, PaperSuiteJsonHasEveryFieldForEveryRow) {
+  const fs::path md = kmbvh::test::temp_path("suite.md"), csv = kmbvh::test::temp_path("suite.csv");
+  const Result r = run("bench --suite paper " + small_obj().string() + " default --builders sweep-sah,Q2,embree-scene "
+                       "--width 48 --height 36 --spp-lq 1 --spp-hq 2 --views 0 --runs 1 --warmup 0 --threads 2 --json -q "
+                       "--markdown " + md.string() + " --csv " + csv.string());
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto rows = nlohmann::json::parse(r.out);
+  ASSERT_EQ(rows.size(), 6u);
+  for (const auto& row : rows) {
+    for (const char* field : {"scene", "triangles", "scene_kind", "builder", "builder_name", "traversal", "layout",
+                              "threads", "build_ms", "build_ms_runs", "layout_ms", "sah_cost", "valid",
+                              "build_bytes_per_triangle", "phases_ms", "lq", "hq", "build_ms_over_sweep_sah",
+                              "sah_cost_over_sweep_sah", "mrays_per_s_over_sweep_sah",
+                              "time_to_image_lq_over_sweep_sah", "time_to_image_hq_over_sweep_sah", "paper_sah_cost",
+                              "paper_mrays_per_s"})
+      EXPECT_TRUE(row.contains(field)) << field << " in " << row["builder"];
+    for (const char* quality : {"lq", "hq"}) {
+      const auto& q = row[quality];
+      for (const char* field : {"spp", "render_ms", "trace_ms", "rays", "shadow_rays", "mrays_per_s", "time_to_image_ms",
+                                "projected"})
+        EXPECT_TRUE(q.contains(field)) << quality << "." << field;
+      EXPECT_GT(q["mrays_per_s"].get<double>(), 0.0);
+      EXPECT_FALSE(q["projected"].get<bool>());
+    }
+    EXPECT_EQ(row["hq"]["spp"], 2);
+    EXPECT_TRUE(row["valid"].get<bool>());
+    EXPECT_GT(row["time_to_image_hq_over_sweep_sah"].get<double>(), 0.0);  // every row, Embree's too
+    const bool embree = row["builder_name"] == "embree-scene";
+    EXPECT_EQ(row["sah_cost"].is_null(), embree);
+    EXPECT_EQ(row["traversal"], embree ? "embree" : "kmbvh");
+  }
+  std::ifstream in(md);
+  const std::string tables((std::istreambuf_iterator<char>(in)), {});
+  EXPECT_NE(tables.find("| Embree end to end |"), std::string::npos) << tables;
+  EXPECT_NE(tables.find("**default**"), std::string::npos) << tables;
+  std::ifstream csv_in(csv);
+  int lines = 0;
+  for (std::string line; std::getline(csv_in, line);) ++lines;
+  EXPECT_EQ(lines, 7);
+}
+
+TEST(Cli, PaperSuiteProjectsHqAndStopsAtItsTimeLimit) {
+  const Result r = run("bench --suite paper " + small_obj().string() + " --builders Q1,Q2 --width 32 --height 24 "
+                       "--spp-lq 2 --project-hq --views 0 --runs 1 --warmup 0 --json -q");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto rows = nlohmann::json::parse(r.out);
+  ASSERT_EQ(rows.size(), 2u);
+  for (const auto& row : rows) {
+    EXPECT_TRUE(row["hq"]["projected"].get<bool>());
+    EXPECT_NEAR(row["hq"]["render_ms"].get<double>(), 64.0 * row["lq"]["render_ms"].get<double>(), 1e-6);
+    EXPECT_TRUE(row["sah_cost_over_sweep_sah"].is_null());  // no sweep-sah row to normalise by
+  }
+  const Result limited = run("bench --suite paper " + small_obj().string() + " --builders Q1,Q2 --width 32 "
+                             "--height 24 --quality lq --time-limit 0.000001 --runs 1 --warmup 0 --json -q");
+  ASSERT_EQ(limited.exit_code, 0) << limited.err;
+  EXPECT_LE(nlohmann::json::parse(limited.out).size(), 1u);
+  EXPECT_NE(limited.err.find("time limit"), std::string::npos) << limited.err;
+}
+
+TEST(Cli, IterationsSuiteBuildsEveryKAndIteration) {
+  const Result r = run("bench --suite iterations " + small_obj().string() + " --ks 8,16 --iterations 0,2,5 --runs 1 "
+                       "--warmup 0 --json -q");
+  ASSERT_EQ(r.exit_code, 0) << r.err;
+  const auto rows = nlohmann::json::parse(r.out);
+  ASSERT_EQ(rows.size(), 6u);
+  EXPECT_EQ(rows[0]["params"]["k"], 8);
+  EXPECT_EQ(rows[0]["params"]["p"], 5);
+  EXPECT_EQ(rows[5]["params"]["k"], 16);
+  EXPECT_EQ(rows[5]["params"]["i"], 5);
+  EXPECT_EQ(run("bench --suite iterations --ks 8,x -q").exit_code, 2);
+}
+
+}  // namespace

@@ -158,6 +158,56 @@ TEST(ObjLoader, FanTriangulatesPolygonsAndResolvesRelativeIndices) {
   EXPECT_EQ(s.triangles[5], (Triangle{2, 3, 4}));
 }
 
+TEST(GltfLoader, ReadsBaseColourAndEmissionPerPrimitive) {
+  tinygltf::Model m = three_node_model();
+  tinygltf::Material red, glowing;
+  red.pbrMetallicRoughness.baseColorFactor = {0.8, 0.1, 0.1, 1.0};
+  glowing.emissiveFactor = {1.0, 0.5, 0.25};
+  tinygltf::Value::Object strength{{"emissiveStrength", tinygltf::Value(4.0)}};
+  glowing.extensions["KHR_materials_emissive_strength"] = tinygltf::Value(strength);
+  m.materials = {red, glowing};
+  m.meshes[0].primitives[0].material = 1;
+  tinygltf::Mesh plain = m.meshes[0];
+  plain.primitives[0].material = -1;  // no material: the grey default
+  m.meshes.push_back(plain);
+  m.nodes[2].mesh = 1;
+  const TriangleScene s = load_scene_file(write_model(m, "materials.glb", true).string());
+  ASSERT_EQ(s.size(), 3u);
+  ASSERT_EQ(s.triangle_material.size(), 3u);
+  const Material first = s.material_of(0), child = s.material_of(2);
+  EXPECT_EQ(first.albedo, Vec3(1.0f));  // glTF's default base colour, white
+  EXPECT_EQ(first.emission, Vec3(4.0f, 2.0f, 1.0f));
+  EXPECT_EQ(child.albedo, Material().albedo);  // grey
+  EXPECT_EQ(child.emission, Vec3(0.0f));
+}
+
+TEST(GltfLoader, OneMaterialKeepsNoPerTriangleArray) {
+  tinygltf::Model m = three_node_model();
+  tinygltf::Material red;
+  red.pbrMetallicRoughness.baseColorFactor = {0.8, 0.1, 0.1, 1.0};
+  m.materials = {red};
+  m.meshes[0].primitives[0].material = 0;
+  const TriangleScene s = load_scene_file(write_model(m, "one-material.glb", true).string());
+  EXPECT_TRUE(s.triangle_material.empty());
+  ASSERT_EQ(s.materials.size(), 1u);
+  EXPECT_EQ(s.material_of(2).albedo, Vec3(0.8f, 0.1f, 0.1f));
+}
+
+TEST(ObjLoader, ReadsDiffuseAndEmissionFromItsMtl) {
+  write_text(temp_file("two.mtl"), "newmtl blue\nKd 0.1 0.2 0.9\nnewmtl lamp\nKd 0 0 0\nKe 5 5 4\n");
+  const fs::path path = temp_file("two.obj");
+  write_text(path,
+             "mtllib two.mtl\nv 0 0 0\nv 1 0 0\nv 1 1 0\nv 0 1 0\n"
+             "f 1 2 3\nusemtl blue\nf 1 3 4\nusemtl lamp\nf 2 3 4\nusemtl missing\nf 1 2 4\n");
+  const TriangleScene s = load_scene_file(path.string());
+  ASSERT_EQ(s.size(), 4u);
+  ASSERT_EQ(s.triangle_material.size(), 4u);
+  EXPECT_EQ(s.material_of(0).albedo, Material().albedo);  // before any usemtl: grey
+  EXPECT_EQ(s.material_of(1).albedo, Vec3(0.1f, 0.2f, 0.9f));
+  EXPECT_EQ(s.material_of(2).emission, Vec3(5.0f, 5.0f, 4.0f));
+  EXPECT_EQ(s.material_of(3).albedo, Material().albedo);  // a material the .mtl lacks: grey
+}
+
 TEST(ObjLoader, BadIndexAndMissingFileAreErrors) {
   const fs::path path = temp_file("bad.obj");
   write_text(path, "v 0 0 0\nv 1 0 0\nv 0 1 0\nf 1 2 99\n");
@@ -311,6 +361,17 @@ TEST(InstancedScene, CopiesOnAGridOverTheTwoWidestAxes) {
   EXPECT_FLOAT_EQ(b.hi.y, 1.0f);
   for (const Triangle& t : grid.triangles)
     for (uint32_t v : t) EXPECT_LT(v, grid.positions.size());
+}
+
+TEST(InstancedScene, EveryCopyKeepsItsMaterials) {
+  TriangleScene mesh;
+  mesh.add_triangle(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(0, 0, 1));
+  mesh.add_triangle(Vec3(0, 1, 0), Vec3(1, 1, 0), Vec3(0, 1, 1));
+  mesh.materials = {Material{Vec3(1, 0, 0), Vec3(0.0f)}, Material{Vec3(0, 0, 1), Vec3(0.0f)}};
+  mesh.triangle_material = {1, 0};
+  const TriangleScene grid = instanced_grid(mesh, 3);
+  ASSERT_EQ(grid.triangle_material.size(), 6u);
+  for (size_t t = 0; t < grid.size(); ++t) EXPECT_EQ(grid.material_of(t).albedo, mesh.material_of(t % 2).albedo) << t;
 }
 
 TEST(InstancedScene, NamesAndBadCounts) {

@@ -136,14 +136,18 @@ EmbreeScene::~EmbreeScene() {
 
 void EmbreeScene::trace(const std::vector<Ray>& rays, Query query, EmbreeRays form, std::vector<Hit>& hits) const {
   hits.resize(rays.size());
-  const long n = long(rays.size());
+  trace(rays.data(), rays.size(), query, form, hits.data());
+}
+
+void EmbreeScene::trace(const Ray* rays, size_t count, Query query, EmbreeRays form, Hit* hits) const {
+  const long n = long(count);
   if (form == EmbreeRays::Single) {
 #pragma omp parallel for schedule(dynamic, 256)
     for (long i = 0; i < n; ++i) trace_single(scene_, rays[size_t(i)], query, hits[size_t(i)]);
   } else {
 #pragma omp parallel for schedule(dynamic, 16)
     for (long p = 0; p < (n + 15) / 16; ++p)
-      trace_packet(scene_, rays.data() + p * 16, int(std::min<long>(16, n - p * 16)), query, hits.data() + p * 16);
+      trace_packet(scene_, rays + p * 16, int(std::min<long>(16, n - p * 16)), query, hits + p * 16);
   }
 }
 

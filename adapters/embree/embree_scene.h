@@ -27,6 +27,7 @@ class EmbreeScene {
   // split across OpenMP threads. Rays Embree would abort on (ray_is_valid false) are not
   // sent to it and come back as misses.
   void trace(const std::vector<Ray>& rays, Query query, EmbreeRays form, std::vector<Hit>& hits) const;
+  void trace(const Ray* rays, size_t n, Query query, EmbreeRays form, Hit* hits) const;
 
   double commit_ms() const { return commit_ms_; }
 

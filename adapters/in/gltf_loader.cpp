@@ -58,6 +58,7 @@ class GltfReader {
       : model_(model), path_(path), scene_(scene) {}
 
   void read() {
+    read_materials();
     std::vector<int> roots;
     if (!model_.scenes.empty()) {
       const int s = model_.defaultScene >= 0 ? model_.defaultScene : 0;
@@ -78,11 +79,37 @@ class GltfReader {
     } else {
       for (int m = 0; m < int(model_.meshes.size()); ++m) add_mesh(m, glm::dmat4(1.0));
     }
+    scene_.compact_materials();
   }
 
  private:
   [[noreturn]] void fail(const std::string& problem) const {
     throw SceneError(fmt::format("{}: {}", path_, problem));
+  }
+
+  // Base colour and emission (glTF's emissiveFactor times KHR_materials_emissive_strength)
+  // of each material, and last the grey default for primitives that name none. Textures
+  // are not read: a textured material renders in its base colour factor.
+  void read_materials() {
+    for (const tinygltf::Material& m : model_.materials) {
+      Material out;
+      const auto& base = m.pbrMetallicRoughness.baseColorFactor;
+      if (base.size() >= 3) out.albedo = Vec3(float(base[0]), float(base[1]), float(base[2]));
+      double strength = 1.0;
+      const auto ext = m.extensions.find("KHR_materials_emissive_strength");
+      if (ext != m.extensions.end() && ext->second.Has("emissiveStrength"))
+        strength = ext->second.Get("emissiveStrength").GetNumberAsDouble();
+      if (m.emissiveFactor.size() >= 3)
+        out.emission = Vec3(float(m.emissiveFactor[0]), float(m.emissiveFactor[1]), float(m.emissiveFactor[2])) *
+                       float(strength);
+      scene_.materials.push_back(out);
+    }
+    scene_.materials.push_back(Material());
+  }
+
+  uint32_t material_index(int material) const {
+    const auto count = static_cast<int>(model_.materials.size());
+    return material >= 0 && material < count ? uint32_t(material) : uint32_t(count);  // else the default
   }
 
   static glm::dmat4 local_transform(const tinygltf::Node& node) {
@@ -255,6 +282,7 @@ class GltfReader {
         for (size_t i = 0; i < indices.size(); ++i) indices[i] = uint32_t(i);
       }
       append(vertices, indices, mode);
+      scene_.triangle_material.resize(scene_.triangles.size(), material_index(prim.material));
     }
   }
 

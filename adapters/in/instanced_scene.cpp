@@ -29,7 +29,9 @@ TriangleScene instanced_grid(const TriangleScene& mesh, uint32_t copies) {
     const auto base = static_cast<uint32_t>(out.positions.size());
     for (const Vec3& p : mesh.positions) out.positions.push_back(p + offset);
     for (const Triangle& t : mesh.triangles) out.triangles.push_back({base + t[0], base + t[1], base + t[2]});
+    out.triangle_material.insert(out.triangle_material.end(), mesh.triangle_material.begin(), mesh.triangle_material.end());
   }
+  out.materials = mesh.materials;
   out.warnings = mesh.warnings;
   return out;
 }

@@ -93,6 +93,18 @@ TriangleScene load_obj(const std::string& path) {
   scene.positions.resize(vertex_count);
   for (size_t i = 0; i < vertex_count; ++i) scene.positions[i] = Vec3(v[3 * i], v[3 * i + 1], v[3 * i + 2]);
 
+  // Diffuse colour (Kd) and emission (Ke) from the .mtl files; faces without a material,
+  // or naming one that is missing, get the grey default, last in the list.
+  const auto& mtl = reader.GetMaterials();
+  for (const tinyobj::material_t& m : mtl) {
+    Material out;
+    out.albedo = Vec3(m.diffuse[0], m.diffuse[1], m.diffuse[2]);
+    out.emission = Vec3(m.emission[0], m.emission[1], m.emission[2]);
+    scene.materials.push_back(out);
+  }
+  scene.materials.push_back(Material());
+  const auto default_material = static_cast<uint32_t>(mtl.size());
+
   for (const tinyobj::shape_t& shape : reader.GetShapes()) {
     const auto& mesh = shape.mesh;
     size_t offset = 0;
@@ -108,10 +120,14 @@ TriangleScene load_obj(const std::string& path) {
         return uint32_t(index);
       };
       for (size_t j = 1; j + 1 < n; ++j) scene.triangles.push_back({vertex(0), vertex(j), vertex(j + 1)});
+      const int material = f < mesh.material_ids.size() ? mesh.material_ids[f] : -1;
+      scene.triangle_material.resize(scene.triangles.size(),
+                                     material >= 0 && size_t(material) < mtl.size() ? uint32_t(material) : default_material);
       offset += n;
     }
   }
   if (scene.triangles.empty()) scene.warnings.push_back("no triangles found");
+  scene.compact_materials();
   return scene;
 }
 

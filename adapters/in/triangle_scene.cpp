@@ -14,10 +14,26 @@ Aabb TriangleScene::bounds() const {
   return b;
 }
 
+Material TriangleScene::material_of(size_t t) const {
+  if (materials.empty()) return Material();
+  return materials[triangle_material.empty() ? 0 : triangle_material[t]];
+}
+
+void TriangleScene::compact_materials() {
+  if (triangle_material.empty()) return;
+  const uint32_t first = triangle_material.front();
+  for (uint32_t m : triangle_material)
+    if (m != first) return;
+  materials = {materials[first]};
+  triangle_material.clear();
+  triangle_material.shrink_to_fit();
+}
+
 void TriangleScene::add_triangle(Vec3 a, Vec3 b, Vec3 c) {
   const auto base = static_cast<uint32_t>(positions.size());
   positions.insert(positions.end(), {a, b, c});
   triangles.push_back({base, base + 1, base + 2});
+  if (!triangle_material.empty()) triangle_material.push_back(0);
 }
 
 PrimitiveSet make_primitive_set(const TriangleScene& scene, size_t* dropped) {

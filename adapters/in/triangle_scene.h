@@ -10,6 +10,7 @@
 
 #include "cuda/core/aabb.h"
 #include "cuda/core/primitive_set.h"
+#include "cuda/render/material.h"
 
 namespace kmbvh {
 
@@ -24,8 +25,17 @@ struct TriangleScene {
   std::vector<Vec3> positions;
   std::vector<Triangle> triangles;    // indices into positions, all in range
   std::vector<std::string> warnings;  // what was skipped, in words
+  // Surfaces for rendering: triangle t has materials[triangle_material[t]]. An empty
+  // triangle_material means one material for all, materials[0], or grey when there is none
+  // (most files have one material: no per-triangle array is kept for them).
+  std::vector<Material> materials;
+  std::vector<uint32_t> triangle_material;
 
   size_t size() const { return triangles.size(); }
+  Material material_of(size_t t) const;
+  // Drops the per-triangle array when every triangle has the same material, keeping that
+  // one; the loaders call it last.
+  void compact_materials();
   Aabb triangle_box(size_t t) const;
   Aabb bounds() const;
   void add_triangle(Vec3 a, Vec3 b, Vec3 c);

@@ -286,7 +286,11 @@ bool trace_wide_ray(const WideBvh<W>& bvh, const Ray& ray, Query query, WideEntr
 template <int W>
 void trace_wide(const WideBvh<W>& bvh, const std::vector<Ray>& rays, Query query, std::vector<Hit>& hits) {
   hits.resize(rays.size());
-  const size_t n = rays.size();
+  trace_wide(bvh, rays.data(), rays.size(), query, hits.data());
+}
+
+template <int W>
+void trace_wide(const WideBvh<W>& bvh, const Ray* rays, size_t n, Query query, Hit* hits) {
   ParallelErrors errors;
 #pragma omp parallel
   {
@@ -305,5 +309,7 @@ template bool trace_wide_ray<4>(const WideBvh<4>&, const Ray&, Query, WideEntry*
 template bool trace_wide_ray<8>(const WideBvh<8>&, const Ray&, Query, WideEntry*, Hit&, const HitFilter&);
 template void trace_wide<4>(const WideBvh<4>&, const std::vector<Ray>&, Query, std::vector<Hit>&);
 template void trace_wide<8>(const WideBvh<8>&, const std::vector<Ray>&, Query, std::vector<Hit>&);
+template void trace_wide<4>(const WideBvh<4>&, const Ray*, size_t, Query, Hit*);
+template void trace_wide<8>(const WideBvh<8>&, const Ray*, size_t, Query, Hit*);
 
 }  // namespace kmbvh

@@ -15,6 +15,8 @@ namespace kmbvh {
 // hits[i] answers rays[i] (Query::Any: found() means occluded); split across threads.
 template <int W>
 void trace_wide(const WideBvh<W>& bvh, const std::vector<Ray>& rays, Query query, std::vector<Hit>& hits);
+template <int W>
+void trace_wide(const WideBvh<W>& bvh, const Ray* rays, size_t n, Query query, Hit* hits);
 
 struct WideEntry {
   uint32_t ref, count;  // as in WideNode: count 0 is an interior node

@@ -37,7 +37,7 @@ uint32_t layout_width(Layout layout) { return layout == Layout::Bvh2 ? 2 : layou
 
 Tracer::Tracer(const Bvh& bvh, const PrimitiveSet& prims, const TriangleScene& scene, Layout layout, Backend backend,
                const std::vector<PrimitiveId>* reported_ids)
-    : layout_(layout), layouts_(std::make_unique<Layouts>()) {
+    : layout_(layout), backend_(backend), layouts_(std::make_unique<Layouts>()) {
   if (backend == Backend::Cuda && layout != Layout::Bvh2)
     throw std::invalid_argument("the CUDA traversal reads the bvh2 layout; bvh4 and bvh8 are CPU SIMD layouts");
   require_backend(backend);
@@ -70,13 +70,18 @@ Tracer::~Tracer() = default;
 Tracer::Tracer(Tracer&&) noexcept = default;
 
 void Tracer::trace(const std::vector<Ray>& rays, Query query, std::vector<Hit>& hits) const {
+  hits.resize(rays.size());
+  if (layouts_->bvh2_gpu) return layouts_->bvh2_gpu->trace(rays.data(), rays.size(), query, hits.data());  // uploads
+  trace(rays.data(), rays.size(), query, hits.data());
+}
+
+void Tracer::trace(const Ray* rays, size_t n, Query query, Hit* hits) const {
   switch (layout_) {
     case Layout::Bvh2:
-      if (!layouts_->bvh2_gpu) return trace_bvh2(layouts_->bvh2, rays, query, hits);
-      hits.resize(rays.size());
-      return layouts_->bvh2_gpu->trace(rays.data(), rays.size(), query, hits.data());
-    case Layout::Bvh4: return trace_wide(layouts_->bvh4, rays, query, hits);
-    case Layout::Bvh8: return trace_wide(layouts_->bvh8, rays, query, hits);
+      if (layouts_->bvh2_gpu) return layouts_->bvh2_gpu->trace_on_device(rays, n, query, hits);
+      return detail::trace_bvh2_cpu(layouts_->bvh2.view(), rays, n, query, hits);
+    case Layout::Bvh4: return trace_wide(layouts_->bvh4, rays, n, query, hits);
+    case Layout::Bvh8: return trace_wide(layouts_->bvh8, rays, n, query, hits);
   }
 }
 

@@ -36,6 +36,10 @@ class Tracer {
   Tracer(Tracer&&) noexcept;
 
   void trace(const std::vector<Ray>& rays, Query query, std::vector<Hit>& hits) const;
+  // The same on arrays in the memory of the tracer's backend: host memory on the CPU,
+  // device memory with the CUDA backend, traced where they are (the path tracer's batches).
+  void trace(const Ray* rays, size_t n, Query query, Hit* hits) const;
+  Backend backend() const { return backend_; }
 
   // One ray on the calling thread, on the CPU whatever the backend: no OpenMP, no
   // allocation (beyond one thread-local stack for trees deeper than any seen in practice),
@@ -57,6 +61,7 @@ class Tracer {
  private:
   struct Layouts;
   Layout layout_;
+  Backend backend_;
   Bvh tree_;
   bool collapsed_ = false;
   double layout_ms_ = 0;

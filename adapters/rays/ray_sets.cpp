@@ -6,6 +6,7 @@
 #include "cuda/core/counter_rng.h"
 #include "cuda/render/camera.h"
 #include "cuda/render/sampling.h"
+#include "cuda/render/surface.h"
 
 namespace kmbvh {
 namespace {
@@ -31,10 +32,6 @@ std::vector<Ray> primary_rays(const Aabb& bounds, size_t count, uint32_t seed) {
   }
   return rays;
 }
-
-struct SurfacePoint {
-  Vec3 position, normal;  // normal faces the side the primary ray came from
-};
 
 }  // namespace
 
@@ -71,6 +68,9 @@ RaySets make_ray_sets(const TriangleScene& scene, size_t count, uint32_t seed, c
   std::vector<Hit> hits;
   trace(sets.primary, hits);
 
+  // Points where primary rays land, and where rays leave them: off the surface as the path
+  // tracer leaves it (surface.h).
+  const float diagonal = length(bounds.extent());
   std::vector<SurfacePoint> points;
   for (size_t i = 0; i < hits.size(); ++i) {
     const Hit& h = hits[i];
@@ -78,21 +78,20 @@ RaySets make_ray_sets(const TriangleScene& scene, size_t count, uint32_t seed, c
     const Ray& r = sets.primary[i];
     Vec3 n = normalize(h.Ng);
     if (dot(n, r.dir) > 0.0f) n = n * -1.0f;
-    points.push_back({r.org + r.dir * h.t, n});
+    SurfacePoint p;  // normal facing the side the primary ray came from
+    p.position = r.org + r.dir * h.t;
+    p.normal = n;
+    p.origin = p.position + n * surface_offset(p.position, diagonal);
+    points.push_back(p);
   }
   if (points.empty()) return sets;
 
-  // Off the surface by a small fraction of the scene (and of the point's own magnitude),
-  // far beyond the rounding of either system's hit point.
-  const float diagonal = length(bounds.extent());
   const Vec3 light = scene_light(bounds);
   sets.shadow.reserve(count);
   sets.diffuse.reserve(count);
   for (size_t i = 0; i < count; ++i) {
     const SurfacePoint& p = points[i % points.size()];
-    const float offset = 1e-5f * diagonal + 1e-6f * (std::fabs(p.position.x) + std::fabs(p.position.y) + std::fabs(p.position.z));
-    const Vec3 origin = p.position + p.normal * offset;
-
+    const Vec3 origin = p.origin;
     const Vec3 target = light + Vec3(counter_unit(seed, kLightJitter, uint32_t(i)) - 0.5f, 0.0f, 0.0f) * (0.02f * diagonal);
     const Vec3 to_light = target - origin;
     const float distance = length(to_light);

@@ -21,6 +21,7 @@ struct Bvh2OnGpu::Impl {};
 Bvh2OnGpu::Bvh2OnGpu(const Bvh2&) { require_backend(Backend::Cuda); }
 Bvh2OnGpu::~Bvh2OnGpu() = default;
 void Bvh2OnGpu::trace(const Ray*, size_t, Query, Hit*) { require_backend(Backend::Cuda); }
+void Bvh2OnGpu::trace_on_device(const Ray*, size_t, Query, Hit*) { require_backend(Backend::Cuda); }
 #endif
 
 namespace detail {

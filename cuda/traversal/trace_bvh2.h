@@ -39,6 +39,9 @@ class Bvh2OnGpu {
   Bvh2OnGpu& operator=(const Bvh2OnGpu&) = delete;
 
   void trace(const Ray* rays, size_t n, Query query, Hit* hits);
+  // The same for rays and hits already in device memory (the GPU path tracer's batches):
+  // no transfer at all.
+  void trace_on_device(const Ray* rays, size_t n, Query query, Hit* hits);
   // The last trace()'s kernel time alone, without the rays' and hits' transfers.
   double last_kernel_ms() const { return last_kernel_ms_; }
 

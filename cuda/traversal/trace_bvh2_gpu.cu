@@ -84,18 +84,23 @@ void Bvh2OnGpu::trace(const Ray* rays, size_t n, Query query, Hit* hits) {
     g.hits.resize(n);
   }
   thrust::copy(rays, rays + n, g.rays.begin());
+  trace_on_device(raw(g.rays), n, query, raw(g.hits));
+  thrust::copy(g.hits.begin(), g.hits.begin() + n, hits);
+}
+
+void Bvh2OnGpu::trace_on_device(const Ray* rays, size_t n, Query query, Hit* hits) {
+  if (n == 0) return;
+  Impl& g = *impl_;
   const auto start = std::chrono::steady_clock::now();  // Thrust's for_each returns when the kernel is done
   if (g.view.stack_size <= kLocalStack) {
-    for_each_ray(n, TraceLocalStack{g.view, raw(g.rays), raw(g.hits), query});
+    for_each_ray(n, TraceLocalStack{g.view, rays, hits, query});
   } else {
     const size_t batch = std::max<size_t>(1, kScratchBytes / (sizeof(TraversalEntry) * g.view.stack_size));
     if (g.scratch.size() < std::min(batch, n) * g.view.stack_size) g.scratch.resize(std::min(batch, n) * g.view.stack_size);
     for (size_t first = 0; first < n; first += batch)
-      for_each_ray(std::min(batch, n - first),
-                   TraceScratchStack{g.view, raw(g.rays), raw(g.hits), query, raw(g.scratch), first});
+      for_each_ray(std::min(batch, n - first), TraceScratchStack{g.view, rays, hits, query, raw(g.scratch), first});
   }
   last_kernel_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
-  thrust::copy(g.hits.begin(), g.hits.begin() + n, hits);
 }
 
 }  // namespace kmbvh

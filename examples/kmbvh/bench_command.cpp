@@ -1,5 +1,8 @@
 // kmbvh bench [SCENES...]: every chosen builder on every scene in one process, so build
-// times can be compared as ratios measured in the same run (DESIGN.md §6).
+// times can be compared as ratios measured in the same run (DESIGN.md §6). Two suites
+// besides: --suite paper (time to image with the path tracer, paper_suite.cpp) and
+// --suite iterations (SAH cost against k-means' Lloyd iterations for several k, the
+// paper's stabilisation figure).
 #include <fmt/format.h>
 
 #include <fstream>
@@ -8,6 +11,7 @@
 #include "commands.h"
 #include "measure.h"
 #include "progress.h"
+#include "render_options.h"
 #include "report.h"
 #include "run_options.h"
 
@@ -24,11 +28,72 @@ void add_bench_command(CLI::App& app, BenchCommand& c) {
   cmd->add_option("--reference", c.reference, "the builder build-time ratios are taken against");
   cmd->add_option("--csv", c.csv_path, "also write the rows to this CSV file");
   add_run_options(*cmd, c.run);
+  cmd->add_option("--suite", c.suite,
+                  "paper: time to image with the path tracer for every builder and Embree end to end (add "
+                  "embree-scene to --builders to choose it); iterations: SAH cost against Lloyd iterations")
+      ->check(CLI::IsMember({"paper", "iterations"}));
+  cmd->add_option("--markdown", c.markdown_path, "--suite paper: also write the tables as Markdown to this file");
+  PaperSuiteOptions& p = c.paper;
+  cmd->add_option("--spp-lq", p.spp_lq, "--suite paper: samples per pixel of LQ images");
+  cmd->add_option("--spp-hq", p.spp_hq, "--suite paper: samples per pixel of HQ images");
+  cmd->add_option("--quality", p.qualities, "--suite paper: lq, hq or lq,hq");
+  cmd->add_flag("--project-hq", p.project_hq,
+                "--suite paper: HQ times from LQ's time per sample pass instead of rendering HQ (marked projected)");
+  cmd->add_option("--time-limit", p.time_limit_s, "--suite paper: start no builder after this many seconds")
+      ->check(CLI::NonNegativeNumber);
+  cmd->add_option("--views", p.views, "--suite paper: which views of each scene, a list of indices or all");
+  cmd->add_option("--images", p.images_dir, "--suite paper: also write each rendered view as PNG into this folder");
+  add_image_options(*cmd, p.render);
+  cmd->add_option("--ks", c.ks, "--suite iterations: the cluster counts k");
+  cmd->add_option("--iterations", c.iterations, "--suite iterations: the Lloyd iteration counts i");
 }
 
+namespace {
+
+std::vector<uint32_t> parse_counts(const std::string& list, const char* option) {
+  std::vector<uint32_t> out;
+  for (const std::string& item : split_list(list)) {
+    size_t used = 0;
+    unsigned long value = 0;
+    try {
+      value = std::stoul(item, &used);
+    } catch (const std::exception&) {
+    }
+    if (used != item.size() || item.empty() || value > 1000)
+      throw std::invalid_argument(fmt::format("{}: '{}' is not a count", option, item));
+    out.push_back(uint32_t(value));
+  }
+  if (out.empty()) throw std::invalid_argument(fmt::format("{}: nothing given", option));
+  return out;
+}
+
+// --suite iterations: k-means for every k of --ks and i of --iterations, p the paper's
+// preset's for that k (Q1-Q3's 5 up to k = 16, Q4's 20 for 32, Q5's 30 for 64).
+std::vector<BuilderConfig> iteration_grid(const BenchCommand& c) {
+  std::vector<BuilderConfig> configs;
+  for (const uint32_t k : parse_counts(c.ks, "--ks"))
+    for (const uint32_t i : parse_counts(c.iterations, "--iterations")) {
+      BuilderOptions o = c.options;
+      o.builder = "kmeans";
+      o.k = k;
+      o.p = k >= 64 ? 30 : k >= 32 ? 20 : 5;
+      o.i = i;
+      BuilderConfig config = builder_config(o, c.run);
+      config.preset.clear();
+      config.kmeans.k = o.k, config.kmeans.p = o.p, config.kmeans.i = o.i;
+      check_config(config);
+      configs.push_back(config);
+    }
+  return configs;
+}
+
+}  // namespace
+
 int run_bench(const BenchCommand& c) {
+  if (c.suite == "paper") return run_paper_suite(c);
   apply_run_options(c.run);
-  const std::vector<BuilderConfig> configs = builder_configs(c.builders, c.options, c.run);
+  const std::vector<BuilderConfig> configs =
+      c.suite == "iterations" ? iteration_grid(c) : builder_configs(c.builders, c.options, c.run);
 
   Progress progress(c.run.quiet);
   std::vector<std::vector<Measurement>> tables;

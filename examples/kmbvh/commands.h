@@ -34,6 +34,7 @@ struct BuilderOptions {
   bool adaptive = false, until_stable = false;
   float settle = 0.0f;
   CLI::Option *adaptive_opt = nullptr, *until_stable_opt = nullptr, *settle_opt = nullptr;
+  bool level_loop = false;  // k-means: every level through the portable level loop (the GPU's path)
   BinaryBuildParams binary;  // ploc radius, treelet size and iterations
 };
 
@@ -43,12 +44,37 @@ struct BuildCommand {
   RunOptions run;
 };
 
+// kmbvh render [SCENE]: the path tracer over one builder's tree, or Embree's (issue #6).
+struct RenderOptions {
+  std::string layout = "bvh8";
+  std::string quality = "lq";  // lq: 8 samples per pixel, hq: 128 (DESIGN.md §6)
+  uint32_t spp = 0;            // overrides the quality's
+  uint32_t width = 1024, height = 768;
+  uint32_t seed = 1;
+  std::string views_file;      // views to read instead of NAME.views.json beside the scene
+};
+
+// kmbvh bench --suite paper: the paper's evaluation, time to image (issue #6).
+struct PaperSuiteOptions {
+  uint32_t spp_lq = 8, spp_hq = 128;
+  std::string qualities = "lq,hq";  // which to run
+  bool project_hq = false;          // HQ times from LQ's time per sample pass instead of rendering HQ
+  double time_limit_s = 0;          // start no system after this many seconds (0: no limit)
+  std::string views = "all";        // which views: a comma-separated list of indices, or all
+  std::string images_dir;           // also write every rendered view as PNG here
+  RenderOptions render;             // layout, size, seed, views file
+};
+
 struct BenchCommand {
   std::vector<std::string> scenes{"sponza_dabrovic", "sibenik", "conference"};
   std::string builders = "all";
   std::string reference = "embree-medium";
   std::string csv_path;
-  BuilderOptions options;  // the reference builders' own parameters
+  std::string markdown_path;
+  std::string suite;        // "" (builds), "paper" (time to image) or "iterations" (SAH against Lloyd iterations)
+  PaperSuiteOptions paper;
+  std::string ks = "8,16,32,64", iterations = "0,1,2,3,4,5,6,8,10,12,15";  // --suite iterations
+  BuilderOptions options;   // the reference builders' own parameters
   RunOptions run;
 };
 
@@ -76,14 +102,27 @@ struct StressCommand {
   RunOptions run;
 };
 
+struct RenderCommand {
+  std::string scene;
+  BuilderOptions builder;
+  RunOptions run{0, 1, 0};  // one timed build, no warm-up: the image is what takes time
+  RenderOptions render;
+  std::string traversal = "kmbvh";  // or embree: Embree's own scene and traversal
+  std::string views = "all";        // indices into the scene's views, or all
+  std::string out_dir = "render";
+};
+
 void add_build_command(CLI::App& app, BuildCommand& command);
 void add_bench_command(CLI::App& app, BenchCommand& command);
 void add_trace_command(CLI::App& app, TraceCommand& command);
 void add_stress_command(CLI::App& app, StressCommand& command);
+void add_render_command(CLI::App& app, RenderCommand& command);
 
 int run_build(const BuildCommand& command);
 int run_bench(const BenchCommand& command);
 int run_stress(const StressCommand& command);
 int run_trace(const TraceCommand& command);
+int run_render(const RenderCommand& command);
+int run_paper_suite(const BenchCommand& command);
 
 }  // namespace kmbvh

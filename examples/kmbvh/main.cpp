@@ -1,7 +1,8 @@
 // kmbvh: build BVHs by k-means clustering (Meister and Bittner 2016) and compare them with
 // Embree's. `kmbvh build` runs one builder on one scene; `kmbvh bench` compares several;
 // `kmbvh trace` sends the same rays through kmbvh's traversal and Embree's; `kmbvh stress`
-// runs every builder on the inputs where builders fail.
+// runs every builder on the inputs where builders fail; `kmbvh render` makes pictures with
+// the path tracer over any builder's tree, or Embree's.
 #include <fmt/format.h>
 
 #include <CLI/CLI.hpp>
@@ -19,10 +20,12 @@ int main(int argc, char** argv) {
   BenchCommand bench;
   TraceCommand trace;
   StressCommand stress;
+  RenderCommand render;
   add_build_command(app, build);
   add_bench_command(app, bench);
   add_trace_command(app, trace);
   add_stress_command(app, stress);
+  add_render_command(app, render);
   try {
     app.parse(argc, argv);
   } catch (const CLI::ParseError& e) {
@@ -34,6 +37,7 @@ int main(int argc, char** argv) {
     if (app.got_subcommand("build")) return run_build(build);
     if (app.got_subcommand("trace")) return run_trace(trace);
     if (app.got_subcommand("stress")) return run_stress(stress);
+    if (app.got_subcommand("render")) return run_render(render);
     return run_bench(bench);
   } catch (const SceneError& e) {
     fmt::print(stderr, "kmbvh: error: {}\n", e.what());

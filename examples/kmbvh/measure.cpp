@@ -24,11 +24,12 @@ double median(std::vector<double> v) {
 
 namespace {
 
-TriangleScene read_scene(const std::string& argument) {
+TriangleScene read_scene(const std::string& argument, std::string* path_out = nullptr) {
   if (argument.empty() || argument == "default") return make_default_scene();
   const auto path = find_scene_file(argument);
   if (!path)
     throw SceneError(fmt::format("{}: no such file (nor a scene of that name in {})", argument, scene_folder()));
+  if (path_out) *path_out = *path;
   return load_scene_file(*path);
 }
 
@@ -37,9 +38,9 @@ TriangleScene read_scene(const std::string& argument) {
 LoadedScene load_scene_argument(const std::string& argument) {
   const auto start = std::chrono::steady_clock::now();
   const auto instanced = parse_instanced_name(argument);
-  TriangleScene scene =
-      instanced ? instanced_grid(read_scene(instanced->base), instanced->copies) : read_scene(argument);
   LoadedScene loaded;
+  TriangleScene scene =
+      instanced ? instanced_grid(read_scene(instanced->base), instanced->copies) : read_scene(argument, &loaded.path);
   loaded.name = scene.name;
   loaded.triangles = scene.size();
   loaded.prims = make_primitive_set(scene, &loaded.dropped);
@@ -99,6 +100,7 @@ Measurement measure(const LoadedScene& scene, const BuilderConfig& config, const
   m.stats = tree_stats(bvh);
   m.validation = validate(bvh, scene.prims, validation_limits(config));
   m.sah_cost = m.validation.sah_reported;
+  if (options.tree) *options.tree = std::move(bvh);
   return m;
 }
 

@@ -17,6 +17,7 @@ namespace kmbvh {
 
 struct LoadedScene {
   std::string name;
+  std::string path;  // the file it was read from; empty for the default scene and NAME@N copies
   size_t triangles = 0;
   size_t dropped = 0;  // triangles left out (non-finite vertices)
   PrimitiveSet prims;
@@ -33,6 +34,7 @@ struct MeasureOptions {
   int runs = 5;
   int warmup = 1;
   std::function<void(const std::string&)> progress;  // optional
+  Bvh* tree = nullptr;  // when set, receives the last run's tree (to trace rays through it)
 };
 
 struct Measurement {

@@ -41,7 +41,7 @@ nlohmann::json to_json(const Measurement& m) {
     params.update({{"k", c.kmeans.k}, {"p", c.kmeans.p}, {"i", c.kmeans.i}, {"seed", c.kmeans.seed},
                    {"metric", to_string(c.kmeans.metric)}, {"wide", c.kmeans.wide},
                    {"preset", c.preset.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.preset)},
-                   {"backend", to_string(c.backend)}});
+                   {"backend", to_string(c.backend)}, {"level_loop", !c.kmeans.cpu_subtrees}});
   }
   nlohmann::json phases = nlohmann::json::object();
   for (const auto& [name, ms] : m.info.phase_ms) phases[name] = ms;

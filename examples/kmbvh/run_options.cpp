@@ -45,6 +45,9 @@ void add_reference_options(CLI::App& cmd, BuilderOptions& o) {
   cmd.add_option("--ploc-radius", o.binary.ploc_radius, "PLOC: neighbours searched on each side");
   cmd.add_option("--treelet-size", o.binary.treelet_size, "ATRBVH: leaves of a restructured treelet");
   cmd.add_option("--treelet-iterations", o.binary.treelet_iterations, "ATRBVH: restructuring passes");
+  cmd.add_flag("--level-loop", o.level_loop,
+               "k-means: run every level through the portable level loop, as the GPU does (no CPU subtree path), so "
+               "its phases are timed apart; the tree is the same");
 }
 
 std::vector<std::string> split_list(const std::string& list) {
@@ -77,6 +80,7 @@ BuilderConfig builder_config(const BuilderOptions& o, const RunOptions& run) {
     if (o.i_opt && o.i_opt->count()) config.kmeans.i = o.i;
     config.kmeans.seed = o.seed;
     config.kmeans.wide = o.wide;
+    config.kmeans.cpu_subtrees = !o.level_loop;
     const auto metric = parse_metric(o.metric);
     if (!metric) throw std::invalid_argument(fmt::format("unknown metric '{}' (means or medians)", o.metric));
     config.kmeans.metric = *metric;
