@@ -40,6 +40,17 @@ def log_x(ax):
     ax.xaxis.set_minor_formatter(matplotlib.ticker.NullFormatter())
 
 
+def panel(ax, title, xlabel, ylabel, log_build_ms=False):
+    """One scene's panel: its title, axis labels and grid, and build time on a log axis."""
+    if log_build_ms:
+        log_x(ax)
+    ax.set_title(title.rsplit(".", 1)[0], fontsize=9)
+    ax.set_xlabel(xlabel, fontsize=8)
+    ax.set_ylabel(ylabel, fontsize=8)
+    ax.tick_params(labelsize=7)
+    ax.grid(True, which="both", alpha=0.3)
+
+
 def save(fig, out_dir, name):
     out_dir.mkdir(parents=True, exist_ok=True)
     for ext in ("png", "svg"):
@@ -93,24 +104,15 @@ def stress_chart(rows, out_dir):
 
 def presets_chart(rows, out_dir):
     scenes = ordered(r["scene"] for r in rows)
-    cols = min(4, len(scenes))
-    lines = (len(scenes) + cols - 1) // cols
-    fig, axes = plt.subplots(lines, cols, figsize=(3.4 * cols, 3.0 * lines), squeeze=False)
-    for ax, scene in zip(axes.flat, scenes):
+    fig, axes = scene_grid(scenes, width=3.4, height=3.0)
+    for ax, scene in zip(axes, scenes):
         for r in (r for r in rows if r["scene"] == scene):
             name = r["builder"].replace("kmeans ", "")
             adaptive = name == "QA"
             ax.scatter(r["build_ms"], r["sah_cost"], color="#c0392b" if adaptive else "#2e86c1",
                        marker="*" if adaptive else "o", s=90 if adaptive else 30, zorder=3)
             ax.annotate(name, (r["build_ms"], r["sah_cost"]), fontsize=7, xytext=(3, 3), textcoords="offset points")
-        log_x(ax)
-        ax.set_title(scene.rsplit(".", 1)[0], fontsize=9)
-        ax.set_xlabel("build ms (log)", fontsize=8)
-        ax.set_ylabel("SAH cost", fontsize=8)
-        ax.tick_params(labelsize=7)
-        ax.grid(True, which="both", alpha=0.3)
-    for ax in list(axes.flat)[len(scenes):]:
-        ax.axis("off")
+        panel(ax, scene, "build ms (log)", "SAH cost", log_build_ms=True)
     fig.suptitle("k-means presets: build time against SAH cost (lower left is better); QA is the adaptive preset")
     fig.tight_layout()
     save(fig, out_dir, "presets")
@@ -233,12 +235,7 @@ def pareto_chart(rows, out_dir):
                         textcoords="offset points")
         front = sorted((points[i] for i in pareto_front(points)))
         ax.plot([p[0] for p in front], [p[1] for p in front], color="grey", linestyle="--", linewidth=1, zorder=2)
-        log_x(ax)
-        ax.set_title(scene.rsplit(".", 1)[0], fontsize=9)
-        ax.set_xlabel("build ms (log)", fontsize=8)
-        ax.set_ylabel("SAH cost", fontsize=8)
-        ax.tick_params(labelsize=7)
-        ax.grid(True, which="both", alpha=0.3)
+        panel(ax, scene, "build ms (log)", "SAH cost", log_build_ms=True)
     fig.suptitle("Speed against quality: build time and SAH cost (lower left is better; dashed: the Pareto front; "
                  "red k-means, blue references, purple Embree)", fontsize=10)
     fig.tight_layout()
@@ -255,12 +252,7 @@ def speed_chart(rows, out_dir):
                        marker="D" if r["traversal"] == "embree" else "o")
             ax.annotate(short(r["builder"]), (r["build_ms"], r["lq"]["mrays_per_s"]), fontsize=6.5, xytext=(3, 2),
                         textcoords="offset points")
-        log_x(ax)
-        ax.set_title(scene.rsplit(".", 1)[0], fontsize=9)
-        ax.set_xlabel("build ms (log)", fontsize=8)
-        ax.set_ylabel("Mrays/s (path tracer, LQ)", fontsize=8)
-        ax.tick_params(labelsize=7)
-        ax.grid(True, which="both", alpha=0.3)
+        panel(ax, scene, "build ms (log)", "Mrays/s (path tracer, LQ)", log_build_ms=True)
     fig.suptitle("Build time against trace speed (upper left is better; diamond: Embree's own traversal)", fontsize=10)
     fig.tight_layout()
     save(fig, out_dir, "speed")
@@ -393,11 +385,7 @@ def iterations_chart(rows, out_dir):
         for k in sorted({r["params"]["k"] for r in mine}):
             line = sorted((r["params"]["i"], r["sah_cost"]) for r in mine if r["params"]["k"] == k)
             ax.plot([p[0] for p in line], [p[1] for p in line], marker="o", markersize=3, label=f"k = {k}")
-        ax.set_title(scene.rsplit(".", 1)[0], fontsize=9)
-        ax.set_xlabel("Lloyd iterations i", fontsize=8)
-        ax.set_ylabel("SAH cost", fontsize=8)
-        ax.tick_params(labelsize=7)
-        ax.grid(True, alpha=0.3)
+        panel(ax, scene, "Lloyd iterations i", "SAH cost")
         ax.legend(fontsize=7)
     fig.suptitle("SAH cost against k-means iterations (p: 5 for k <= 16, 20 for 32, 30 for 64)", fontsize=10)
     fig.tight_layout()
@@ -422,10 +410,7 @@ def phases_chart(rows, out_dir):
             heights = [r["phases_ms"].get(phase, 0.0) for r in mine]
             ax.bar(names, heights, bottom=bottom, color=cmap(k % 10), label=phase)
             bottom = [b + h for b, h in zip(bottom, heights)]
-        ax.set_title(scene.rsplit(".", 1)[0], fontsize=9)
-        ax.set_ylabel("ms (last run)", fontsize=8)
-        ax.tick_params(labelsize=7)
-        ax.grid(True, axis="y", alpha=0.3)
+        panel(ax, scene, "", "ms (last run)")
     axes[0].legend(fontsize=7)
     fig.suptitle("k-means build time by phase (the portable level loop, as on the GPU)", fontsize=10)
     fig.tight_layout()

@@ -41,6 +41,9 @@ fi
 if wanted hq; then
   rm -rf "$out/images"
   run hq.json ${hq_cmd} --images "$out/images"
+  for f in "$out"/images/*.png; do  # JPEG for the page: a fifth of the size
+    oiiotool "$f" --attrib Compression jpeg:90 -o "${f%.png}.jpg" && rm "$f"
+  done
 fi
 wanted iterations && run iterations.json ${iterations_cmd}
 wanted phases && run phases.json ${phases_cmd}
@@ -57,9 +60,9 @@ echo "== tables and charts"
 python=/usr/bin/python3
 "$python" scripts/charts.py all "$out"
 machine="$(lscpu | sed -n 's/^Model name: *//p' | head -1), $(nproc) cores, $(. /etc/os-release && echo "$PRETTY_NAME"), $(g++ --version | head -1)"
-images=""
-for f in "$out"/images/*-HQ-view0.png; do
-  [ -e "$f" ] && images+="![$(basename "$f" .png)](results/images/$(basename "$f")) "
+images=""  # the HQ pictures, then the LQ ones
+for f in "$out"/images/*-HQ-view0.jpg "$out"/images/*-LQ-view0.jpg; do
+  [ -e "$f" ] && images+="![$(basename "$f" .jpg)](results/images/$(basename "$f")) "
 done
 {
   cat <<PAGE

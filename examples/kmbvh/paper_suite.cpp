@@ -6,9 +6,12 @@
 // sweep SAH's, as the paper normalises. One process, so ratios compare like for like.
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
+#include <filesystem>
 #include <fstream>
 #include <nlohmann/json.hpp>
+#include <functional>
 #include <optional>
 
 #include "adapters/out/image_file.h"
@@ -232,81 +235,102 @@ std::string csv_row(const SuiteRow& r) {
                      cell(r.tti_hq_over_sweep, "{:.4f}"));
 }
 
+// What one suite run renders with, checked once.
+struct SuitePlan {
+  std::vector<RenderSystem> systems;
+  std::optional<RenderSettings> lq, hq;
+  bool project_hq = false;
+};
+
+SuitePlan plan(const BenchCommand& c) {
+  const PaperSuiteOptions& p = c.paper;
+  SuitePlan plan;
+  const std::vector<std::string> qualities = split_list(p.qualities);
+  for (const std::string& q : qualities)
+    if (q != "lq" && q != "hq") throw std::invalid_argument(fmt::format("--quality: '{}' is not lq or hq", q));
+  const auto wants = [&](const char* q) { return std::find(qualities.begin(), qualities.end(), q) != qualities.end(); };
+  if (!wants("lq") && !wants("hq")) throw std::invalid_argument("--quality: lq, hq or both");
+  if (p.project_hq && !wants("lq")) throw std::invalid_argument("--project-hq derives HQ from LQ: --quality must include lq");
+  if (p.spp_lq == 0 || p.spp_hq == 0) throw std::invalid_argument("--spp-lq and --spp-hq must be at least 1");
+  RenderOptions options = p.render;
+  options.spp = p.spp_lq;
+  if (wants("lq")) plan.lq = render_settings(options);
+  options.spp = p.spp_hq;
+  if (wants("hq")) plan.hq = render_settings(options);
+  plan.project_hq = p.project_hq;
+  plan.systems = suite_systems(c);
+  return plan;
+}
+
+// One system on one scene: built, laid out, and each view rendered at the plan's qualities.
+SuiteRow run_system(const LoadedScene& scene, const RenderScene& look, const std::vector<int>& views,
+                    const RenderSystem& system, const SuitePlan& plan, const BenchCommand& c,
+                    const std::function<void(const std::string&)>& report) {
+  MeasureOptions options;
+  options.runs = c.run.runs;
+  options.warmup = c.run.warmup;
+  options.progress = report;
+  const PreparedSystem prepared(scene, look, system, options);
+  SuiteRow row;
+  row.scene = scene.name;
+  row.triangles = scene.triangles;
+  row.kind = look.kind;
+  row.system = system;
+  row.threads = thread_count();
+  row.build_ms = prepared.build_ms();
+  row.build_ms_runs = prepared.build_ms_runs();
+  row.layout_ms = prepared.layout_ms();
+  row.measurement = prepared.measurement();
+  const double fixed_ms = row.build_ms + row.layout_ms;
+  auto render_views = [&](const RenderSettings& settings, const char* quality) {
+    std::vector<ViewRender> renders;
+    for (const int v : views) {
+      report(fmt::format("{}: {} {} view {}", scene.name, system.label(), quality, v));
+      renders.push_back(prepared.render(v, settings));
+      if (!c.paper.images_dir.empty())
+        write_image(fmt::format("{}/{}-{}-{}-view{}.png", c.paper.images_dir, slug(scene_stem(scene.name)),
+                                slug(system.label()), quality, v),
+                    renders.back().image);
+      renders.back().image = Image();  // only the times are kept
+    }
+    return renders;
+  };
+  if (plan.lq) row.lq = summarise(render_views(*plan.lq, "LQ"), plan.lq->spp, fixed_ms);
+  if (plan.hq)
+    row.hq = plan.project_hq ? project(*row.lq, plan.hq->spp, fixed_ms)
+                             : summarise(render_views(*plan.hq, "HQ"), plan.hq->spp, fixed_ms);
+  return row;
+}
+
 }  // namespace
 
 int run_paper_suite(const BenchCommand& c) {
   apply_run_options(c.run);
   const PaperSuiteOptions& p = c.paper;
-  const std::vector<std::string> qualities = split_list(p.qualities);
-  const auto wants = [&](const char* q) { return std::find(qualities.begin(), qualities.end(), q) != qualities.end(); };
-  for (const std::string& q : qualities)
-    if (q != "lq" && q != "hq") throw std::invalid_argument(fmt::format("--quality: '{}' is not lq or hq", q));
-  const bool lq_wanted = wants("lq"), hq_wanted = wants("hq");
-  if (!lq_wanted && !hq_wanted) throw std::invalid_argument("--quality: lq, hq or both");
-  if (p.project_hq && !lq_wanted) throw std::invalid_argument("--project-hq derives HQ from LQ: --quality must include lq");
-  if (p.spp_lq == 0 || p.spp_hq == 0) throw std::invalid_argument("--spp-lq and --spp-hq must be at least 1");
-  const std::vector<RenderSystem> systems = suite_systems(c);
-  RenderOptions lq_options = p.render, hq_options = p.render;
-  lq_options.spp = p.spp_lq;
-  hq_options.spp = p.spp_hq;
-  const RenderSettings lq_settings = render_settings(lq_options), hq_settings = render_settings(hq_options);
+  const SuitePlan suite = plan(c);
+  const RenderSettings& shape = suite.lq ? *suite.lq : *suite.hq;  // the images' size
   if (!p.images_dir.empty()) std::filesystem::create_directories(p.images_dir);
 
   Progress progress(c.run.quiet);
   const auto start = std::chrono::steady_clock::now();
-  const size_t total = c.scenes.size() * systems.size();
+  const size_t total = c.scenes.size() * suite.systems.size();
   size_t step = 0, skipped = 0;
   std::vector<std::vector<SuiteRow>> tables;
   for (const std::string& scene_argument : c.scenes) {
     progress.step(step, total, fmt::format("loading {}", scene_argument));
     const LoadedScene scene = load_scene_argument(scene_argument);
-    const RenderScene look = prepare_render_scene(scene.geometry, scene.prims,
-                                                  float(lq_settings.width) / float(lq_settings.height), scene.path,
-                                                  p.render.views_file);
+    const RenderScene look = prepare_render_scene(scene.geometry, scene.prims, float(shape.width) / float(shape.height),
+                                                  scene.path, p.render.views_file);
     const std::vector<int> views = parse_views(p.views, look.views.size());
     std::vector<SuiteRow> rows;
-    for (const RenderSystem& system : systems) {
+    for (const RenderSystem& system : suite.systems) {
       const double elapsed = std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
       if (p.time_limit_s > 0 && elapsed > p.time_limit_s) {
         ++skipped, ++step;
         continue;
       }
-      const std::string what = fmt::format("{}: {}", scene.name, system.label());
-      auto report = [&](const std::string& message) { progress.step(step, total, what + " " + message); };
-      MeasureOptions options;
-      options.runs = c.run.runs;
-      options.warmup = c.run.warmup;
-      options.progress = [&](const std::string& message) { progress.step(step, total, message); };
-      const PreparedSystem prepared(scene, look, system, options);
-      SuiteRow row;
-      row.scene = scene.name;
-      row.triangles = scene.triangles;
-      row.kind = look.kind;
-      row.system = system;
-      row.threads = thread_count();
-      row.build_ms = prepared.build_ms();
-      row.build_ms_runs = prepared.build_ms_runs();
-      row.layout_ms = prepared.layout_ms();
-      row.measurement = prepared.measurement();
-      const double fixed_ms = row.build_ms + row.layout_ms;
-      auto render_views = [&](const RenderSettings& settings, const char* quality) {
-        std::vector<ViewRender> renders;
-        for (const int v : views) {
-          report(fmt::format("{} view {}", quality, v));
-          renders.push_back(prepared.render(v, settings));
-          if (!p.images_dir.empty())
-            write_image(fmt::format("{}/{}-{}-{}-view{}.png", p.images_dir,
-                                    slug(scene.name.substr(0, scene.name.rfind('.'))), slug(system.label()), quality, v),
-                        renders.back().image);
-          renders.back().image = Image();
-        }
-        return renders;
-      };
-      if (lq_wanted) row.lq = summarise(render_views(lq_settings, "LQ"), lq_settings.spp, fixed_ms);
-      if (hq_wanted)
-        row.hq = p.project_hq ? project(*row.lq, hq_settings.spp, fixed_ms)
-                              : summarise(render_views(hq_settings, "HQ"), hq_settings.spp, fixed_ms);
-      rows.push_back(std::move(row));
+      rows.push_back(run_system(scene, look, views, system, suite, c,
+                                [&](const std::string& message) { progress.step(step, total, message); }));
       ++step;
     }
     normalise(rows);

@@ -57,7 +57,7 @@ int run_render(const RenderCommand& c) {
   options.warmup = c.run.warmup;
   options.progress = [&](const std::string& message) { progress.update(message); };
   const PreparedSystem prepared(scene, look, system, options);
-  const std::string stem = fmt::format("{}/{}-{}", c.out_dir, slug(scene.name.substr(0, scene.name.rfind('.'))),
+  const std::string stem = fmt::format("{}/{}-{}", c.out_dir, slug(scene_stem(scene.name)),
                                        slug(system.embree ? system.label() : system.label() + " " + c.render.layout));
   std::vector<ViewRender> renders;
   Json view_rows = Json::array();

@@ -54,4 +54,6 @@ std::string slug(std::string s) {
   return s;
 }
 
+std::string scene_stem(const std::string& scene_name) { return scene_name.substr(0, scene_name.rfind('.')); }
+
 }  // namespace kmbvh

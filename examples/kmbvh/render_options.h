@@ -21,4 +21,7 @@ std::vector<int> parse_views(const std::string& list, size_t count);
 // "kmeans Q2" -> "kmeans-Q2": a label as part of a file name.
 std::string slug(std::string label);
 
+// "conference.glb" -> "conference": a scene's name without its extension.
+std::string scene_stem(const std::string& scene_name);
+
 }  // namespace kmbvh
