@@ -260,11 +260,12 @@ def speed_chart(rows, out_dir):
 
 def tti_chart(rows, out_dir):
     """Time to image over sweep SAH's, LQ above and HQ below: a group of bars per scene, a bar
-    per system, as the paper's figures show it."""
+    per system, as the paper's figures show it; each bar drawn from 1 (sweep SAH) so that
+    differences of a few percent stay visible."""
     scenes = ordered(r["scene"] for r in rows)
     systems = ordered(r["builder"] for r in rows)
     cmap = matplotlib.colormaps["tab20"]
-    fig, axes = plt.subplots(2, 1, figsize=(max(8.0, 1.1 * len(scenes) * (1 + 0.18 * len(systems))), 7.5))
+    fig, axes = plt.subplots(2, 1, figsize=(min(18.0, max(8.0, 0.08 * len(scenes) * len(systems))), 8.0))
     width = 0.85 / max(1, len(systems))
     for ax, quality in zip(axes, ("lq", "hq")):
         for k, system in enumerate(systems):
@@ -275,7 +276,7 @@ def tti_chart(rows, out_dir):
                 if value:
                     xs.append(i + (k - (len(systems) - 1) / 2) * width)
                     ys.append(value)
-            ax.bar(xs, ys, width=width, color=cmap(k % 20), label=short(system))
+            ax.bar(xs, [y - 1.0 for y in ys], bottom=1.0, width=width, color=cmap(k % 20), label=short(system))
         ax.axhline(1.0, color="grey", linewidth=0.8)
         ax.set_xticks(range(len(scenes)), [s.rsplit(".", 1)[0] for s in scenes], fontsize=8)
         ax.set_ylabel(f"time to image {quality.upper()} / sweep SAH", fontsize=8)

@@ -36,7 +36,7 @@ scaling_cmd="kmbvh bench teapot bunny_stanford conference conference@4 conferenc
 run() { local file=$1; shift; echo "== $*"; "$kmbvh" "${@:2}" --json -q > "$out/$file.tmp" && mv "$out/$file.tmp" "$out/$file"; }
 
 if wanted suite; then
-  run suite.json ${suite_cmd} --markdown "$out/suite.md"
+  run suite.json ${suite_cmd} --markdown "$out/suite.md" --csv "$out/suite.csv"
 fi
 if wanted hq; then
   rm -rf "$out/images"
@@ -177,7 +177,7 @@ PAGE
 
 ![Build time and memory against triangles](results/scaling.png)
 
-Raw data: [suite.json](results/suite.json), [hq.json](results/hq.json),
+Raw data: [suite.json](results/suite.json) ([CSV](results/suite.csv)), [hq.json](results/hq.json),
 [iterations.json](results/iterations.json), [phases.json](results/phases.json),
 [presets.json](results/presets.json), [stress.json](results/stress.json),
 [scaling.json](results/scaling.json).
