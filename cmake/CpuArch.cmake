@@ -20,3 +20,9 @@ if(KMBVH_CPU_ARCH)
                       $<$<COMPILE_LANGUAGE:CUDA>:-Xcompiler=-march=${KMBVH_CPU_ARCH}>)
 endif()
 message(STATUS "kmbvh: host code for -march=${KMBVH_CPU_ARCH}")
+
+# No floating-point contraction anywhere: g++ in ISO mode (-std=c++17) never contracts, but
+# clang fuses a*b+c within an expression by default. The same source then computes other
+# rays and other double-precision checks under clang (the sanitizer build) than under g++,
+# and the watertight test (cuda/CMakeLists.txt, kmbvh_traversal) needs it off in any case.
+add_compile_options($<$<COMPILE_LANGUAGE:CXX>:-ffp-contract=off>)

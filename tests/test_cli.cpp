@@ -8,6 +8,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "kmbvh/version.h"
 #include "support/temp_files.h"
 
 namespace {
@@ -45,6 +46,12 @@ fs::path small_obj() {
       out << "f " << a << " " << a + 41 << " " << a + 42 << " " << a + 1 << "\n";
     }
   return path;
+}
+
+TEST(Cli, PrintsItsVersion) {
+  const Result r = run("--version");
+  EXPECT_EQ(r.exit_code, 0) << r.err;
+  EXPECT_EQ(r.out, "kmbvh " KMBVH_VERSION "\n");
 }
 
 TEST(Cli, BuildJsonHasEveryField) {

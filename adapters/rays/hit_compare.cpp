@@ -57,18 +57,21 @@ Meet meet(const TriangleScene& scene, uint32_t prim, const Ray& ray, double& t, 
 using Ground = ExactAnswers::Answer;
 
 Ground brute_force(const TriangleScene& scene, const Ray& ray) {
+  // Whether a clear hit exists is reduced apart from its distance: OpenMP starts a min
+  // reduction's private copies at the type's largest value, which libgomp takes as +inf
+  // and libomp (clang) as DBL_MAX, so "nearest is infinite" cannot mean "no clear hit".
   double nearest = std::numeric_limits<double>::infinity();
-  bool any = false;
+  bool any = false, clear = false;
   const auto n = int64_t(scene.triangles.size());
-#pragma omp parallel for schedule(static) reduction(min : nearest) reduction(|| : any) if (n >= 65536)
+#pragma omp parallel for schedule(static) reduction(min : nearest) reduction(|| : any, clear) if (n >= 65536)
   for (int64_t p = 0; p < n; ++p) {
     double t;
     const Meet m = meet(scene, uint32_t(p), ray, t);
     if (m == Meet::None) continue;
     any = true;
-    if (m == Meet::Clear) nearest = std::min(nearest, t);
+    if (m == Meet::Clear) nearest = std::min(nearest, t), clear = true;
   }
-  return {nearest, any};
+  return {clear ? nearest : std::numeric_limits<double>::infinity(), any};
 }
 
 bool same_t(const Ray& ray, double a, double b) { return std::fabs(a - b) <= kRelT * t_scale(ray, std::max(a, b)); }

@@ -11,10 +11,12 @@
 
 #include "adapters/in/triangle_scene.h"
 #include "commands.h"
+#include "kmbvh/version.h"
 
 int main(int argc, char** argv) {
   using namespace kmbvh;
   CLI::App app{"kmbvh: k-means BVH construction, measured against Embree"};
+  app.set_version_flag("--version", "kmbvh " KMBVH_VERSION);
   app.require_subcommand(1);
   BuildCommand build;
   BenchCommand bench;
