@@ -5,6 +5,7 @@
 
 #include <cmath>
 #include <limits>
+#include <optional>
 
 #include "adapters/builder_registry.h"
 #include "adapters/embree/embree_scene.h"
@@ -177,6 +178,43 @@ Ray make_ray(Vec3 org, Vec3 dir, float tnear = 0.0f, float tfar = kInf) {
   r.tnear = tnear;
   r.tfar = tfar;
   return r;
+}
+
+// The wide traversal's counters on a tree small enough to count by hand: a root with three
+// leaves, {0}, {1, 2} and {3}, triangles side by side in z = 0, and rays straight down.
+TEST(TraversalCounters, CountedByHandOnAThreeLeafTree) {
+  TriangleScene scene;
+  for (const float x : {0.0f, 10.0f, 12.0f, 20.0f}) scene.add_triangle(Vec3(x, 0, 0), Vec3(x + 1, 0, 0), Vec3(x, 1, 0));
+  const PrimitiveSet prims = make_primitive_set(scene);
+  Bvh bvh;
+  bvh.prim_indices = {0, 1, 2, 3};
+  bvh.nodes = {BvhNode::make_interior(scene.bounds(), 1, 3), BvhNode::make_leaf(prims.boxes[0], 0, 1),
+               BvhNode::make_leaf(join(prims.boxes[1], prims.boxes[2]), 1, 2), BvhNode::make_leaf(prims.boxes[3], 3, 1)};
+  ASSERT_TRUE(validate(bvh, prims, ValidationLimits{2, 3}).ok());
+  const std::vector<Ray> rays = {make_ray(Vec3(0.2f, 0.2f, 5), Vec3(0, 0, -1)),   // onto triangle 0
+                                 make_ray(Vec3(10.2f, 0.2f, 5), Vec3(0, 0, -1)),  // onto 1, beside 2 in its leaf
+                                 make_ray(Vec3(5, 0.5f, 5), Vec3(0, 0, -1))};     // between the leaves' boxes
+  for (const Layout layout : {Layout::Bvh4, Layout::Bvh8}) {
+    const Tracer tracer(bvh, prims, scene, layout);
+    ASSERT_FALSE(tracer.collapsed());
+    for (const Query query : {Query::Closest, Query::Any}) {
+      const std::optional<TraversalCounters> c = tracer.count(rays, query);
+      ASSERT_TRUE(c.has_value());
+      EXPECT_EQ(c->rays, 3u);
+      EXPECT_EQ(c->nodes, 3u);         // the root, once per ray
+      EXPECT_EQ(c->packs, 2u);         // the first two rays' leaves
+      EXPECT_EQ(c->triangles, 3u);     // one, then two
+      EXPECT_EQ(c->exact_checks, 2u);  // one accepted hit each
+      // Counting changes nothing of the answers.
+      std::vector<Hit> hits;
+      tracer.trace(rays, query, hits);
+      EXPECT_EQ(hits[0].primID, 0u);
+      EXPECT_EQ(hits[1].primID, 1u);
+      EXPECT_FALSE(hits[2].found());
+    }
+  }
+  // The portable BVH2 kernel counts nothing (a binary tree over the same triangles).
+  EXPECT_FALSE(Tracer(chain_tree(prims), prims, scene, Layout::Bvh2).count(rays, Query::Closest).has_value());
 }
 
 TEST(Traversal, EmbreeConventionsOnASquare) {

@@ -3,6 +3,7 @@
 #include <immintrin.h>
 #include <omp.h>
 
+#include <algorithm>
 #include <cstring>
 #include <type_traits>
 
@@ -92,6 +93,20 @@ inline unsigned enter_children(const WideNode<W>& n, const WideRay<W>& r, float 
   return mask_bits(t0 <= t1 * kRobustExit);
 }
 
+// Counting compiled in or out: the traversal calls these at every step, and the uncounted
+// variant's are empty.
+struct NoTally {
+  void node() {}
+  void pack(uint32_t) {}
+  void exact() {}
+};
+struct Tally {
+  TraversalCounters c;
+  void node() { ++c.nodes; }
+  void pack(uint32_t triangles) { ++c.packs, c.triangles += triangles; }
+  void exact() { ++c.exact_checks; }
+};
+
 // The watertight test's per-ray set-up, broadcast to the slots of a pack.
 struct PackRay {
   const Ray& ray;  // for the exact check of accepted hits
@@ -110,10 +125,12 @@ struct PackRay {
 
 // The watertight test (cuda/traversal/watertight.h) on a pack of triangles at once, in the
 // same operations as the scalar test. Returns the slot of the nearest hit in (tnear,
-// tmax] and its t, or -1. A slot whose edge functions come out exactly zero goes to the
-// scalar test, which redoes them in double precision.
+// tmax] and its t, or -1; for Query::Any, the first slot found to be hit, since any one
+// will do. A slot whose edge functions come out exactly zero goes to the scalar test,
+// which redoes them in double precision.
 // `skip`: slots a hit filter has already turned down for this ray (0 without a filter).
-inline int intersect_pack(const TrianglePack& p, const PackRay& r, float tnear, float tmax, float& t_hit,
+template <Query query, typename Count>
+inline int intersect_pack(const TrianglePack& p, const PackRay& r, float tnear, float tmax, float& t_hit, Count& count,
                           unsigned skip = 0) {
   const RayShear& s = r.shear;
   vfp x[3], y[3], z[3];
@@ -140,6 +157,7 @@ inline int intersect_pack(const TrianglePack& p, const PackRay& r, float tnear, 
   unsigned redo = mask_bits(exact_zero) & ~skip;
   auto vertex = [&](int v, int slot) { return Vec3(p.v[v][0][slot], p.v[v][1][slot], p.v[v][2][slot]); };
   auto exact = [&](int slot) {  // watertight.h: exact_t_within
+    count.exact();
     return exact_t_within(r.ray, vertex(0, slot), vertex(1, slot), vertex(2, slot), tnear, tmax);
   };
   int best = -1;
@@ -147,22 +165,33 @@ inline int intersect_pack(const TrianglePack& p, const PackRay& r, float tnear, 
     const vfp t = T / det;
     for (; hits; hits &= hits - 1) {
       const int slot = __builtin_ctz(hits);
-      if ((best < 0 || t[slot] < t_hit) && exact(slot)) best = slot, t_hit = t[slot];
+      if ((best < 0 || t[slot] < t_hit) && exact(slot)) {
+        best = slot, t_hit = t[slot];
+        if (query == Query::Any) return best;
+      }
     }
   }
   for (; redo; redo &= redo - 1) {
     const int slot = __builtin_ctz(redo);
     Hit h;
     if (intersect_watertight(s, tnear, best < 0 ? tmax : t_hit, vertex(0, slot), vertex(1, slot), vertex(2, slot), h) &&
-        exact(slot))
+        exact(slot)) {
       best = slot, t_hit = h.t;
+      if (query == Query::Any) return best;
+    }
   }
   return best;
 }
 
+// Completes the hit on triangle `found` (hit.t is set): its ids, and unless `refine` is
+// false (an unfiltered occlusion query, which needs only the yes), its Ng, t, u and v
+// measured again in double precision (watertight.h: refine_hit).
 template <int W>
-bool finish_hit(const WideBvh<W>& bvh, const Ray& ray, uint32_t found, Hit& hit) {
+bool finish_hit(const WideBvh<W>& bvh, const Ray& ray, uint32_t found, Hit& hit, bool refine = true) {
   if (found == kInvalidId) return false;
+  hit.geomID = bvh.ids[found].geom;
+  hit.primID = bvh.ids[found].prim;
+  if (!refine) return true;
   const TrianglePack& p = bvh.packs[found / kPackWidth];
   const uint32_t slot = found % kPackWidth;
   const Vec3 a(p.v[0][0][slot], p.v[0][1][slot], p.v[0][2][slot]);
@@ -170,19 +199,26 @@ bool finish_hit(const WideBvh<W>& bvh, const Ray& ray, uint32_t found, Hit& hit)
   const Vec3 c(p.v[2][0][slot], p.v[2][1][slot], p.v[2][2][slot]);
   hit.Ng = cross(b - a, c - a);
   refine_hit(ray, a, b, c, hit);
-  hit.geomID = bvh.ids[found].geom;
-  hit.primID = bvh.ids[found].prim;
   return true;
+}
+
+// A ray's end: its counts, when counted, go to `counted`.
+inline bool finish(NoTally, TraversalCounters*, bool found) { return found; }
+inline bool finish(const Tally& t, TraversalCounters* counted, bool found) {
+  *counted += t.c;
+  ++counted->rays;
+  return found;
 }
 
 // The traversal, compiled once per query so the inner loop carries no test of it.
 // With a filter (Filtered), every candidate hit is offered to it before it counts, as
 // Embree offers hits to an application's filter functions; a refused one is skipped and
 // the traversal goes on.
-template <int W, Query query, bool Filtered = false>
-bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit, const HitFilter* filter = nullptr) {
+template <int W, Query query, bool Filtered = false, typename Count = NoTally>
+bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit, const HitFilter* filter = nullptr,
+              Count count = {}, TraversalCounters* counted = nullptr) {
   hit = Hit();
-  if (bvh.nodes.empty() || !ray_can_hit(ray)) return false;
+  if (bvh.nodes.empty() || !ray_can_hit(ray)) return finish(count, counted, false);
   const RayBoxSetup setup(ray);
   const WideRay<W> wray(setup);
   const PackRay pack_ray(ray);
@@ -193,6 +229,7 @@ bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit,
   for (;;) {
     if (cur.count == 0) {
       const WideNode<W>& n = bvh.nodes[cur.ref];
+      count.node();
       // The children's references sit on the node's last line and are read only once the
       // box test is done: fetch that line now, alongside the boxes.
       _mm_prefetch(reinterpret_cast<const char*>(n.ref), _MM_HINT_T0);
@@ -232,19 +269,20 @@ bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit,
     }
     for (uint32_t p = cur.ref, end = cur.ref + (cur.count + kPackWidth - 1) / kPackWidth; p < end; ++p) {
       float t;
+      count.pack(std::min<uint32_t>(kPackWidth, cur.count - (p - cur.ref) * kPackWidth));
       if (!Filtered) {
-        const int slot = intersect_pack(bvh.packs[p], pack_ray, ray.tnear, tmax, t);
+        const int slot = intersect_pack<query>(bvh.packs[p], pack_ray, ray.tnear, tmax, t, count);
         if (slot < 0) continue;
         found = p * kPackWidth + uint32_t(slot);
         hit.t = t;
-        if (query == Query::Any) return finish_hit(bvh, ray, found, hit);
+        if (query == Query::Any) return finish(count, counted, finish_hit(bvh, ray, found, hit, false));
         tmax = t;
         continue;
       }
       // The pack's nearest slot first; one the filter refuses is skipped and the next
       // nearest tried.
       for (unsigned skip = 0;;) {
-        const int slot = intersect_pack(bvh.packs[p], pack_ray, ray.tnear, tmax, t, skip);
+        const int slot = intersect_pack<Query::Closest>(bvh.packs[p], pack_ray, ray.tnear, tmax, t, count, skip);
         if (slot < 0) break;
         const uint32_t candidate = p * kPackWidth + uint32_t(slot);
         Hit offered;
@@ -255,7 +293,7 @@ bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit,
           continue;
         }
         hit = offered;
-        if (query == Query::Any) return true;
+        if (query == Query::Any) return finish(count, counted, true);
         found = candidate;
         tmax = t;
         break;  // the pack's other slots are farther
@@ -263,7 +301,7 @@ bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit,
     }
   pop:
     do {
-      if (sp == 0) return Filtered ? found != kInvalidId : finish_hit(bvh, ray, found, hit);
+      if (sp == 0) return finish(count, counted, Filtered ? found != kInvalidId : finish_hit(bvh, ray, found, hit));
       cur = stack[--sp];
     } while (cur.entry > tmax);
   }
@@ -289,16 +327,38 @@ void trace_wide(const WideBvh<W>& bvh, const std::vector<Ray>& rays, Query query
   trace_wide(bvh, rays.data(), rays.size(), query, hits.data());
 }
 
+TraversalCounters& TraversalCounters::operator+=(const TraversalCounters& o) {
+  rays += o.rays;
+  nodes += o.nodes;
+  packs += o.packs;
+  triangles += o.triangles;
+  exact_checks += o.exact_checks;
+  return *this;
+}
+
 template <int W>
-void trace_wide(const WideBvh<W>& bvh, const Ray* rays, size_t n, Query query, Hit* hits) {
+void trace_wide(const WideBvh<W>& bvh, const Ray* rays, size_t n, Query query, Hit* hits, TraversalCounters* counters) {
   ParallelErrors errors;
 #pragma omp parallel
   {
     std::vector<WideEntry> stack;
+    TraversalCounters mine;
     errors.capture([&] { stack.resize(bvh.stack_size); });
 #pragma omp for schedule(dynamic, 256)
-    for (size_t i = 0; i < n; ++i)
-      if (!errors.failed()) trace_wide_ray(bvh, rays[i], query, stack.data(), hits[i]);
+    for (size_t i = 0; i < n; ++i) {
+      if (errors.failed()) continue;
+      if (!counters) {
+        trace_wide_ray(bvh, rays[i], query, stack.data(), hits[i]);
+      } else if (query == Query::Any) {
+        traverse<W, Query::Any, false, Tally>(bvh, rays[i], stack.data(), hits[i], nullptr, Tally{}, &mine);
+      } else {
+        traverse<W, Query::Closest, false, Tally>(bvh, rays[i], stack.data(), hits[i], nullptr, Tally{}, &mine);
+      }
+    }
+    if (counters) {
+#pragma omp critical(kmbvh_traversal_counters)
+      *counters += mine;
+    }
   }
   errors.rethrow();
 }
@@ -309,7 +369,7 @@ template bool trace_wide_ray<4>(const WideBvh<4>&, const Ray&, Query, WideEntry*
 template bool trace_wide_ray<8>(const WideBvh<8>&, const Ray&, Query, WideEntry*, Hit&, const HitFilter&);
 template void trace_wide<4>(const WideBvh<4>&, const std::vector<Ray>&, Query, std::vector<Hit>&);
 template void trace_wide<8>(const WideBvh<8>&, const std::vector<Ray>&, Query, std::vector<Hit>&);
-template void trace_wide<4>(const WideBvh<4>&, const Ray*, size_t, Query, Hit*);
-template void trace_wide<8>(const WideBvh<8>&, const Ray*, size_t, Query, Hit*);
+template void trace_wide<4>(const WideBvh<4>&, const Ray*, size_t, Query, Hit*, TraversalCounters*);
+template void trace_wide<8>(const WideBvh<8>&, const Ray*, size_t, Query, Hit*, TraversalCounters*);
 
 }  // namespace kmbvh

@@ -12,18 +12,35 @@
 
 namespace kmbvh {
 
-// hits[i] answers rays[i] (Query::Any: found() means occluded); split across threads.
+// What the traversal did for a batch of rays, summed over them: counts that do not move
+// with the machine's load, to decide between traversal variants where timings on shared
+// machines move by 10-20%.
+struct TraversalCounters {
+  uint64_t rays = 0;
+  uint64_t nodes = 0;         // interior nodes whose child boxes the ray was tested against
+  uint64_t packs = 0;         // leaf triangle packs tested
+  uint64_t triangles = 0;     // triangles in those packs (used slots only)
+  uint64_t exact_checks = 0;  // accepted hits confirmed in double precision (exact_t_within)
+  TraversalCounters& operator+=(const TraversalCounters& o);
+};
+
+// hits[i] answers rays[i] (Query::Any: found() means occluded); split across threads. With
+// `counters`, the traversal counts what it does into them (a separately compiled variant:
+// the uncounted one carries no counting at all).
 template <int W>
 void trace_wide(const WideBvh<W>& bvh, const std::vector<Ray>& rays, Query query, std::vector<Hit>& hits);
 template <int W>
-void trace_wide(const WideBvh<W>& bvh, const Ray* rays, size_t n, Query query, Hit* hits);
+void trace_wide(const WideBvh<W>& bvh, const Ray* rays, size_t n, Query query, Hit* hits,
+                TraversalCounters* counters = nullptr);
 
 struct WideEntry {
   uint32_t ref, count;  // as in WideNode: count 0 is an interior node
   float entry;          // where the ray enters its box: skipped once a closer hit is known
 };
 
-// One ray; `stack` holds bvh.stack_size entries.
+// One ray; `stack` holds bvh.stack_size entries. For Query::Any the hit names the
+// occluding triangle and its t from the float test, unrefined (Embree's occlusion queries
+// report only that something is hit); Query::Closest refines it in double precision.
 template <int W>
 bool trace_wide_ray(const WideBvh<W>& bvh, const Ray& ray, Query query, WideEntry* stack, Hit& hit);
 

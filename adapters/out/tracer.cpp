@@ -85,6 +85,17 @@ void Tracer::trace(const Ray* rays, size_t n, Query query, Hit* hits) const {
   }
 }
 
+std::optional<TraversalCounters> Tracer::count(const std::vector<Ray>& rays, Query query) const {
+  std::vector<Hit> hits(rays.size());
+  TraversalCounters counters;
+  switch (layout_) {
+    case Layout::Bvh2: return std::nullopt;
+    case Layout::Bvh4: trace_wide(layouts_->bvh4, rays.data(), rays.size(), query, hits.data(), &counters); break;
+    case Layout::Bvh8: trace_wide(layouts_->bvh8, rays.data(), rays.size(), query, hits.data(), &counters); break;
+  }
+  return counters;
+}
+
 namespace {
 
 // The traversal stack of trace_one: on the C++ stack up to this many entries (6 KiB),

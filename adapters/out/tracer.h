@@ -5,6 +5,7 @@
 #pragma once
 
 #include <memory>
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -40,6 +41,10 @@ class Tracer {
   // device memory with the CUDA backend, traced where they are (the path tracer's batches).
   void trace(const Ray* rays, size_t n, Query query, Hit* hits) const;
   Backend backend() const { return backend_; }
+  // The same rays traced once more, on the CPU, counting what the traversal does
+  // (trace_wide.h: TraversalCounters); std::nullopt for bvh2, whose portable kernel counts
+  // nothing.
+  std::optional<TraversalCounters> count(const std::vector<Ray>& rays, Query query) const;
 
   // One ray on the calling thread, on the CPU whatever the backend: no OpenMP, no
   // allocation (beyond one thread-local stack for trees deeper than any seen in practice),

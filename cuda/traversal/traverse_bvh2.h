@@ -19,10 +19,13 @@ struct TraversalEntry {
   float entry;          // where the ray enters its box: skipped once a closer hit is known
 };
 
-KMBVH_HD KMBVH_INLINE bool finish_bvh2_hit(const Bvh2View& view, const Ray& ray, uint32_t found, Hit& hit) {
+// The hit on triangle `found`, its t, u, v and Ng measured again in double precision
+// unless `refine` is false: an occlusion query needs only the yes (as Embree's reports).
+KMBVH_HD KMBVH_INLINE bool finish_bvh2_hit(const Bvh2View& view, const Ray& ray, uint32_t found, Hit& hit,
+                                           bool refine = true) {
   if (found == kInvalidId) return false;
   const LeafTriangle& tri = view.triangles[found];
-  refine_hit(ray, tri.a, tri.b, tri.c, hit);
+  if (refine) refine_hit(ray, tri.a, tri.b, tri.c, hit);
   hit.geomID = view.ids[found].geom;
   hit.primID = view.ids[found].prim;
   return true;
@@ -30,7 +33,7 @@ KMBVH_HD KMBVH_INLINE bool finish_bvh2_hit(const Bvh2View& view, const Ray& ray,
 
 // Closest hit (query Closest) or any hit (query Any) within [ray.tnear, ray.tfar].
 // `stack` holds view.stack_size entries. Returns whether a hit was found; for Closest,
-// `hit` holds it.
+// `hit` holds it, refined; for Any, the occluding triangle and its float t.
 KMBVH_HD KMBVH_INLINE bool trace_bvh2(const Bvh2View& view, const Ray& ray, Query query, TraversalEntry* stack,
                                       Hit& hit) {
   hit = Hit();
@@ -70,7 +73,7 @@ KMBVH_HD KMBVH_INLINE bool trace_bvh2(const Bvh2View& view, const Ray& ray, Quer
         if (query == Query::Any) break;
         tmax = hit.t;
       }
-      if (query == Query::Any && found != kInvalidId) return finish_bvh2_hit(view, ray, found, hit);
+      if (query == Query::Any && found != kInvalidId) return finish_bvh2_hit(view, ray, found, hit, false);
       do {
         if (sp == 0) return finish_bvh2_hit(view, ray, found, hit);
         cur = stack[--sp];

@@ -66,7 +66,29 @@ struct KindResult {
   double kernel_mrays = 0;  // GPU: the kernel alone, transfers excluded
   const EmbreeResult* embree = nullptr;
   HitComparison comparison;
+  std::optional<TraversalCounters> counters;  // wide layouts
 };
+
+Json counters_json(const TraversalCounters& c) {
+  const double rays = c.rays ? double(c.rays) : 1.0;
+  return Json{{"rays", c.rays},
+              {"nodes_per_ray", double(c.nodes) / rays},
+              {"packs_per_ray", double(c.packs) / rays},
+              {"triangles_per_ray", double(c.triangles) / rays},
+              {"exact_checks_per_ray", double(c.exact_checks) / rays},
+              {"nodes", c.nodes},
+              {"packs", c.packs},
+              {"triangles", c.triangles},
+              {"exact_checks", c.exact_checks}};
+}
+
+void print_counters(const KindResult& r) {
+  if (!r.counters) return;
+  const TraversalCounters& c = *r.counters;
+  const double rays = c.rays ? double(c.rays) : 1.0;
+  fmt::print("  {} per ray: {:.2f} nodes, {:.2f} leaf packs, {:.2f} triangles, {:.2f} exact checks\n", to_string(r.kind),
+             double(c.nodes) / rays, double(c.packs) / rays, double(c.triangles) / rays, double(c.exact_checks) / rays);
+}
 
 void print_kernel_rate(const KindResult& r) {
   if (r.kernel_mrays > 0)
@@ -182,6 +204,7 @@ int run_trace(const TraceCommand& c) {
                         kernel_ms.push_back(tracer.last_kernel_ms());
                       }));
       r.kernel_mrays = mrays(r.rays, median(kernel_ms) * 1e-3);
+      r.counters = tracer.count(rays.of(kind), query_for(kind));
       if (embree) {
         r.embree = &embree_results[int(kind)];
         r.comparison = compare_hits(scene.geometry, rays.of(kind), query_for(kind), hits, r.embree->hits, c.show);
@@ -195,6 +218,7 @@ int run_trace(const TraceCommand& c) {
       for (const KindResult& r : results) {
         Json k{{"kind", to_string(r.kind)}, {"rays", r.rays}, {"kmbvh_mrays_per_s", r.mrays}};
         if (r.kernel_mrays > 0) k["kmbvh_kernel_mrays_per_s"] = r.kernel_mrays;
+        if (r.counters) k["counters"] = counters_json(*r.counters);
         if (r.embree) {
           k["embree_mrays_per_s"] = r.embree->single_mrays;
           k["embree16_mrays_per_s"] = r.embree->packet_mrays;
@@ -219,12 +243,14 @@ int run_trace(const TraceCommand& c) {
       if (!r.embree) {
         fmt::print("{:<8} {:>8} {:>13.2f}\n", to_string(r.kind), r.rays, r.mrays);
         print_kernel_rate(r);
+        print_counters(r);
         continue;
       }
       fmt::print("{:<8} {:>8} {:>13.2f} {:>13.2f} {:>7.2f} {:>13.2f} {:>10} {:>9}\n", to_string(r.kind), r.rays, r.mrays,
                  r.embree->single_mrays, r.embree->single_mrays > 0 ? r.mrays / r.embree->single_mrays : 0.0,
                  r.embree->packet_mrays, r.comparison.mismatches(), r.comparison.edge_ties);
       print_kernel_rate(r);
+      print_counters(r);
       const HitComparison& m = r.comparison;
       if (m.mismatches())
         fmt::print("  {} {} mismatches: hit/miss {}, distance {}, primitive {}, normal {}, barycentrics {}\n",
