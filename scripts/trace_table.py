@@ -1,5 +1,5 @@
 #!/usr/bin/env python3
-"""Trace speed of kmbvh's traversal against Embree's, as a Markdown table (issue #4).
+"""Trace speed of kmbvh's traversal against Embree's, as a Markdown table.
 
 Runs `kmbvh trace --compare-embree --json` for each scene, builder and thread count, and
 prints, per ray kind, kmbvh's Mrays/s on the chosen layout, Embree's rtcIntersect1 /

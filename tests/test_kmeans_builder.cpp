@@ -1,4 +1,4 @@
-// The k-means builder end to end (issue #2): valid trees for every preset, metric and
+// The k-means builder end to end: valid trees for every preset, metric and
 // output arity on random scenes, free parameters, determinism across thread counts, and
 // the degenerate inputs.
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// Each step of the k-means builder alone (issue #2): distance, initialisation, assignment,
+// Each step of the k-means builder alone: distance, initialisation, assignment,
 // the mean and median updates, and the agglomerative merge order, against brute force.
 #include <gtest/gtest.h>
 

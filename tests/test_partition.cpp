@@ -1,4 +1,4 @@
-// The partition of a level by cluster (issue #2): the final assignment counts per piece,
+// The partition of a level by cluster: the final assignment counts per piece,
 // PlaceClusters turns counts into cursors, ScatterPiece moves primitives. Checked on a
 // hand-made level of two segments, one of them spread over several pieces.
 #include <gtest/gtest.h>

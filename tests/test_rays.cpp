@@ -1,4 +1,4 @@
-// Rays through the trees (issue #2): a plain traversal of each builder's tree finds the
+// Rays through the trees: a plain traversal of each builder's tree finds the
 // same closest hit as brute force over all triangles, for thousands of random rays.
 #include <gtest/gtest.h>
 

@@ -1,4 +1,4 @@
-// The paper's reference builders and PLOC (issue #3): valid trees on random and degenerate
+// The paper's reference builders and PLOC: valid trees on random and degenerate
 // sets, the same tree for any thread count, parameters honoured; the sweep SAH builder
 // picks the cheapest split at every node (exhaustive check); LBVH's radix tree matches an
 // independent reference; the CPU radix sort matches std::stable_sort.

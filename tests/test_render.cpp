@@ -1,4 +1,4 @@
-// The path tracer (issue #6): radiance it must get exactly (a furnace, a small light over a
+// The path tracer: radiance it must get exactly (a furnace, a small light over a
 // plane), images that do not depend on threads, wave size or layout, kmbvh's traversal
 // against Embree's on the same seed, the scene survey's rooms and objects, views files,
 // and images to files and back.

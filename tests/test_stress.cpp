@@ -1,4 +1,4 @@
-// The stability suite (issue 7): every stress case through every kmbvh builder must give a
+// The stability suite: every stress case through every kmbvh builder must give a
 // valid tree whose hits are Embree's, and Embree's own builders must at least be run and
 // reported. Sizes are small here; `kmbvh stress` runs the full ones (1M identical triangles).
 #include <gtest/gtest.h>

@@ -1,4 +1,4 @@
-// kmbvh's traversal (issue #4): every layout over every builder's tree gives the hits a
+// kmbvh's traversal: every layout over every builder's tree gives the hits a
 // brute-force loop over all triangles gives; any-hit agrees with closest-hit; degenerate
 // rays and triangles; trees deeper than any fixed stack.
 #include <gtest/gtest.h>

@@ -1,5 +1,5 @@
 // Scenes made in code: random triangle soups for tests, and the stress cases of
-// `kmbvh stress` (issue 7), the inputs on which BVH builders are known to fail: empty and
+// `kmbvh stress`, the inputs on which BVH builders are known to fail: empty and
 // tiny scenes, identical, nested, zero-area, collinear and coplanar triangles, needles,
 // non-finite vertices, duplicates, huge ranges of scale, outliers and regular grids.
 #pragma once

@@ -1,4 +1,4 @@
-// A scene made ready for the path tracer (issue #6): its materials as a diffuse surface can
+// A scene made ready for the path tracer: its materials as a diffuse surface can
 // have them, its lighting, and its views. The views are read from NAME.views.json beside
 // the scene file when there is one (or from a file given), else found by the scene's
 // survey (scene_survey.h), which also places the light.

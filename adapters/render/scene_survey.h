@@ -1,5 +1,5 @@
 // Where to look from and where to put the light, found by casting rays into the scene
-// (issue #6: 3 views per scene, a default light when the scene has none). A scene is a
+// (3 views per scene, a default light when the scene has none). A scene is a
 // room when some point inside it sees mostly surfaces that face it (walls from inside)
 // with at most half of its rays escaping; the most open such point is the room's middle.
 // Rooms are seen from inside, along their longest free line (the nave) both ways and from

@@ -1,7 +1,7 @@
 // What each node of the k-means build gets: how many clusters (k), how many candidates per
 // representative at initialisation (p), how many Lloyd iterations at most, and whether its
 // loop may stop early. The paper's presets (Table 1) fix k, p and i for the whole tree and
-// switch to k = 2 below m * k primitives; the adaptive preset (issue 7: a model no bigger
+// switch to k = 2 below m * k primitives; the adaptive preset (a model no bigger
 // than the node needs) chooses them from the node's size instead, and stops iterating once
 // an iteration moves few enough primitives. The level loop and the CPU subtree path both
 // decide through these rules, so they build the same tree.

@@ -1,4 +1,4 @@
-// The full validation every builder's tree must pass (issue #2): every primitive exactly
+// The full validation every builder's tree must pass: every primitive exactly
 // once, every child box inside its parent's, leaf sizes within bounds, no empty interior
 // node, and the SAH cost recomputed from the primitives equal to the one the tree reports.
 #pragma once

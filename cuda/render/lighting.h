@@ -1,4 +1,4 @@
-// What lights a rendered scene (issue #6): one rectangular area light, sampled by next-event
+// What lights a rendered scene: one rectangular area light, sampled by next-event
 // estimation, and a sky that paths reach by escaping the scene. Emissive surfaces
 // (material.h) glow too, found by the paths that hit them. Portable.
 #pragma once

@@ -1,4 +1,4 @@
-// The path tracer's one kind of surface (issue #6): Lambertian reflection of a colour, and
+// The path tracer's one kind of surface: Lambertian reflection of a colour, and
 // optionally emitted radiance, both in linear RGB. Portable, read by the shading kernel.
 #pragma once
 

@@ -1,4 +1,4 @@
-// The path tracer's per-path kernels (issue #6; DESIGN.md §6): a wavefront of paths, one
+// The path tracer's per-path kernels (DESIGN.md §6): a wavefront of paths, one
 // work item per path, written once for the CPU and the GPU. Paths are diffuse: at each hit
 // the path adds the surface's emission, sends `shadow_samples` shadow rays to the area
 // light (next-event estimation), and continues in a cosine-weighted direction, ended by

@@ -1,4 +1,4 @@
-// The path tracer (issue #6): renders one view of a scene, sample pass after sample pass,
+// The path tracer: renders one view of a scene, sample pass after sample pass,
 // each pass a wavefront of paths (path_kernels.h) whose rays go to a traversal in dense
 // batches. The traversal is a parameter: kmbvh's over any builder's tree and layout, or
 // Embree's, so the same renderer makes the image and times it for every one of them.

@@ -2,7 +2,7 @@
 // in double precision: the point, the geometric normal facing the ray, and the origin of the
 // rays that leave it. Every traversal (kmbvh's layouts, Embree's) that reports the same
 // triangle then gives the very same point, so images agree bit for bit wherever the
-// triangles agree (issue #6). Portable.
+// triangles agree. Portable.
 #pragma once
 
 #include "cuda/core/vec3.h"

@@ -44,7 +44,7 @@ struct BuildCommand {
   RunOptions run;
 };
 
-// kmbvh render [SCENE]: the path tracer over one builder's tree, or Embree's (issue #6).
+// kmbvh render [SCENE]: the path tracer over one builder's tree, or Embree's.
 struct RenderOptions {
   std::string layout = "bvh8";
   std::string quality = "lq";  // lq: 8 samples per pixel, hq: 128 (DESIGN.md §6)
@@ -54,7 +54,7 @@ struct RenderOptions {
   std::string views_file;      // views to read instead of NAME.views.json beside the scene
 };
 
-// kmbvh bench --suite paper: the paper's evaluation, time to image (issue #6).
+// kmbvh bench --suite paper: the paper's evaluation, time to image.
 struct PaperSuiteOptions {
   uint32_t spp_lq = 8, spp_hq = 128;
   std::string qualities = "lq,hq";  // which to run
@@ -90,7 +90,7 @@ struct TraceCommand {
   size_t show = 5;               // mismatching rays printed in full
 };
 
-// kmbvh stress [CASES...]: every builder on the generated stress cases (issue 7).
+// kmbvh stress [CASES...]: every builder on the generated stress cases.
 struct StressCommand {
   std::vector<std::string> cases;  // empty: all
   std::string builders = "all";

@@ -1,4 +1,4 @@
-// One system making the images of a scene (issue #6): a kmbvh builder's tree in one of
+// One system making the images of a scene: a kmbvh builder's tree in one of
 // kmbvh's layouts, or Embree's own scene and traversal. Built once, measured as `bench`
 // measures builds (median of runs after a warm-up), then rendering any view at any quality
 // with the same path tracer, so `render` and `bench --suite paper` time every system alike.

@@ -1,4 +1,4 @@
-// The stability suite (issue 7): every builder on every generated stress case, with the
+// The stability suite: every builder on every generated stress case, with the
 // tree validated and the same rays traced through kmbvh's traversal of it and through
 // Embree's own scene. A builder "fails" a case when it throws, returns an invalid tree, or
 // its tree gives hits that differ from Embree's.

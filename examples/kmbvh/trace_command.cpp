@@ -1,6 +1,6 @@
 // kmbvh trace SCENE --builder B --layout L --rays K --count N --compare-embree: the same
 // rays through kmbvh's traversal over B's tree and through Embree's own scene, every
-// difference counted, and the speed of both (issue #4; DESIGN.md §6).
+// difference counted, and the speed of both (DESIGN.md §6).
 #include <fmt/format.h>
 
 #include <chrono>
