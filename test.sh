@@ -26,15 +26,13 @@ fi
 jobs=$(nproc)
 
 stages=()
-stage_start=$SECONDS
 run_start=$SECONDS
 stage() {  # stage NAME COMMAND...: runs it and records how long it took
-  local name=$1
+  local name=$1 start=$SECONDS
   shift
   echo "== $name"
-  stage_start=$SECONDS
   "$@"
-  local took=$((SECONDS - stage_start))
+  local took=$((SECONDS - start))
   stages+=("$(printf '%-44s %4d:%02d' "$name" $((took / 60)) $((took % 60)))")
   echo "== $name: $((took / 60)) min $((took % 60)) s"
 }
