@@ -69,13 +69,15 @@ struct KindResult {
   std::optional<TraversalCounters> counters;  // wide layouts
 };
 
+// A count over the batch's rays, as an average per ray.
+double per_ray(uint64_t count, const TraversalCounters& c) { return c.rays ? double(count) / double(c.rays) : 0.0; }
+
 Json counters_json(const TraversalCounters& c) {
-  const double rays = c.rays ? double(c.rays) : 1.0;
   return Json{{"rays", c.rays},
-              {"nodes_per_ray", double(c.nodes) / rays},
-              {"packs_per_ray", double(c.packs) / rays},
-              {"triangles_per_ray", double(c.triangles) / rays},
-              {"exact_checks_per_ray", double(c.exact_checks) / rays},
+              {"nodes_per_ray", per_ray(c.nodes, c)},
+              {"packs_per_ray", per_ray(c.packs, c)},
+              {"triangles_per_ray", per_ray(c.triangles, c)},
+              {"exact_checks_per_ray", per_ray(c.exact_checks, c)},
               {"nodes", c.nodes},
               {"packs", c.packs},
               {"triangles", c.triangles},
@@ -85,9 +87,8 @@ Json counters_json(const TraversalCounters& c) {
 void print_counters(const KindResult& r) {
   if (!r.counters) return;
   const TraversalCounters& c = *r.counters;
-  const double rays = c.rays ? double(c.rays) : 1.0;
   fmt::print("  {} per ray: {:.2f} nodes, {:.2f} leaf packs, {:.2f} triangles, {:.2f} exact checks\n", to_string(r.kind),
-             double(c.nodes) / rays, double(c.packs) / rays, double(c.triangles) / rays, double(c.exact_checks) / rays);
+             per_ray(c.nodes, c), per_ray(c.packs, c), per_ray(c.triangles, c), per_ray(c.exact_checks, c));
 }
 
 void print_kernel_rate(const KindResult& r) {

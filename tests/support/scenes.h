@@ -22,8 +22,9 @@ using kmbvh::zero_area_triangles;
 std::vector<std::string> scene_files();
 
 // One file per geometry: an OBJ whose glTF twin (same name, .glb or .gltf) is in the folder
-// is left out, since the twins load to the same triangles (Loaders.TwinFilesLoadToTheSame-
-// Triangles checks it), so tracing both would test the same thing twice.
+// is left out, since the twins load to the same triangles (tests/test_scenes.cpp:
+// SceneFolder.TwinFilesLoadToTheSameTriangles checks it), so tracing both would test the
+// same thing twice.
 std::vector<std::string> distinct_scene_files();
 
 // The OBJ files of the folder that have a glTF twin, each with that twin.
