@@ -1,20 +1,13 @@
-# Instruction set for all host code. The kernels' distance loops vectorise well with AVX2,
-# so the default is x86-64-v3 where the build machine has it, and x86-64-v4 (AVX-512) where
-# it has that too: the wide traversal's masks and packed-triangle tests run 10-25% faster
-# with it (measured with `kmbvh trace`, README). The same flag everywhere, so inline
-# functions never differ between objects. KMBVH_CPU_ARCH="" keeps the compiler's.
-set(_kmbvh_default_arch "")
-if(EXISTS /proc/cpuinfo)
-  file(READ /proc/cpuinfo _kmbvh_cpuinfo)
-  if(_kmbvh_cpuinfo MATCHES " avx2" AND _kmbvh_cpuinfo MATCHES " fma" AND _kmbvh_cpuinfo MATCHES " bmi2")
-    set(_kmbvh_default_arch "x86-64-v3")
-    if(_kmbvh_cpuinfo MATCHES " avx512f" AND _kmbvh_cpuinfo MATCHES " avx512bw" AND _kmbvh_cpuinfo MATCHES " avx512cd"
-       AND _kmbvh_cpuinfo MATCHES " avx512dq" AND _kmbvh_cpuinfo MATCHES " avx512vl")
-      set(_kmbvh_default_arch "x86-64-v4")
-    endif()
-  endif()
-endif()
-set(KMBVH_CPU_ARCH "${_kmbvh_default_arch}" CACHE STRING "-march for host code (empty: compiler default)")
+# Instruction set for all host code: x86-64-v2 (SSE4.2), so that one build runs on every
+# x86-64 CPU of the last fifteen years, whatever machine built it. What pays for more is
+# compiled for more and chosen at run time: the wide traversal has SSE4.2, AVX2 and AVX-512
+# kernels (adapters/out/cpu_isa.h). The builders were measured at x86-64-v2 and -v3 on an
+# AVX2 machine (conference, 2 threads, `kmbvh build --runs 5`): k-means Q1 and Q3 within
+# noise of each other, LBVH about 10% slower at v2. KMBVH_CPU_ARCH=native (or x86-64-v3,
+# x86-64-v4) builds for the build machine only; "" keeps the compiler's default. The same
+# flag everywhere, so inline functions never differ between objects (the traversal's
+# kernels raise it only inside their own target regions).
+set(KMBVH_CPU_ARCH "x86-64-v2" CACHE STRING "-march for host code (empty: compiler default)")
 if(KMBVH_CPU_ARCH)
   add_compile_options($<$<COMPILE_LANGUAGE:CXX>:-march=${KMBVH_CPU_ARCH}>
                       $<$<COMPILE_LANGUAGE:CUDA>:-Xcompiler=-march=${KMBVH_CPU_ARCH}>)

@@ -1,4 +1,4 @@
-# Thrust for the CPU backend (DESIGN.md §3), compiled by g++ with the OpenMP device system.
+# Thrust for the CPU backend (docs/design.md §3), compiled by g++ with the OpenMP device system.
 # KMBVH_THRUST picks the copy: "cccl" is CUDA's CCCL (3.x, the same Thrust nvcc uses),
 # "system" is Debian's libthrust-dev (1.17); "auto" prefers CCCL when it is installed.
 set(KMBVH_THRUST "auto" CACHE STRING "Thrust for the CPU backend: auto, cccl or system")

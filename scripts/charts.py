@@ -326,7 +326,7 @@ def targets_table(rows, out_path):
 
 
 # The paper's SAH cost over full sweep SAH's, averaged over its nine scenes (Meister and
-# Bittner 2016; DESIGN.md section 4).
+# Bittner 2016; docs/design.md §4).
 PAPER_AVERAGE_SAH_OVER_SWEEP = {"Q1": 1.19, "Q2": 1.08, "Q3": 1.01, "Q4": 0.97, "Q5": 0.94, "lbvh": 1.27,
                                 "hlbvh": 1.09, "atrbvh": 0.86}
 

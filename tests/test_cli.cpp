@@ -8,6 +8,7 @@
 #include <fstream>
 #include <nlohmann/json.hpp>
 
+#include "adapters/out/cpu_isa.h"
 #include "kmbvh/version.h"
 #include "support/temp_files.h"
 
@@ -143,9 +144,11 @@ TEST(Cli, TraceComparesWithEmbree) {
         EXPECT_TRUE(kind["comparison"].contains(field)) << field;
       // The wide layouts count what their traversal does; the portable BVH2 kernel does not.
       if (layout["layout"] == "bvh2") {
+        EXPECT_EQ(layout["isa"], "portable");
         EXPECT_FALSE(kind.contains("counters"));
         continue;
       }
+      EXPECT_EQ(layout["isa"], kmbvh::to_string(kmbvh::traversal_isa()));
       EXPECT_EQ(kind["counters"]["rays"], 3000);
       EXPECT_GE(kind["counters"]["nodes_per_ray"].get<double>(), 1.0);
       EXPECT_GT(kind["counters"]["triangles_per_ray"].get<double>(), 0.0);

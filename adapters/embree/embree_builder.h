@@ -1,6 +1,6 @@
 // Embree's own builders as a kmbvh builder: rtcBuildBVH with callbacks that record the tree
 // Embree makes, converted into kmbvh's Bvh so it is measured by the same code as every
-// other builder (DESIGN.md §5).
+// other builder (docs/design.md §5).
 #pragma once
 
 #include <cstdint>

@@ -1,5 +1,5 @@
 // Embree's own scene and traversal over the same triangles kmbvh traces: the oracle and
-// the performance reference of `kmbvh trace` (DESIGN.md §6). One triangle mesh (geomID 0,
+// the performance reference of `kmbvh trace` (docs/design.md §6). One triangle mesh (geomID 0,
 // primID = the triangle's index in the scene), committed with rtcCommitScene, traced with
 // rtcIntersect1 / rtcOccluded1 per ray or rtcIntersect16 / rtcOccluded16 per packet.
 #pragma once

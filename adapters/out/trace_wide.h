@@ -1,12 +1,13 @@
 // Rays through a 4- or 8-wide layout on the CPU: every child box of a node in one SIMD
-// slab test (AVX2 for 8 lanes and SSE for 4 when the build targets x86-64-v3; GCC's
-// vector extensions split or widen as the target allows), then the entered children
-// ordered by distance, nearest first. Same ray conventions and triangle test as the
-// portable BVH2 kernel (cuda/traversal), so every layout gives the same answer.
+// slab test, then the entered children ordered by distance, nearest first; the kernel is
+// compiled for SSE4.2, AVX2 and AVX-512 and the best the CPU runs is used (cpu_isa.h).
+// Same ray conventions and triangle test as the portable BVH2 kernel (cuda/traversal), so
+// every layout gives the same answer.
 #pragma once
 
 #include <vector>
 
+#include "cpu_isa.h"
 #include "cuda/traversal/ray.h"
 #include "wide_bvh.h"
 
@@ -20,7 +21,7 @@ struct TraversalCounters {
   uint64_t nodes = 0;         // interior nodes whose child boxes the ray was tested against
   uint64_t packs = 0;         // leaf triangle packs tested
   uint64_t triangles = 0;     // triangles in those packs (used slots only)
-  uint64_t exact_checks = 0;  // accepted hits confirmed in double precision (exact_t_within)
+  uint64_t exact_checks = 0;  // candidate hits confirmed in double precision (watertight.h: exact_check)
   TraversalCounters& operator+=(const TraversalCounters& o);
 };
 
@@ -32,6 +33,12 @@ void trace_wide(const WideBvh<W>& bvh, const std::vector<Ray>& rays, Query query
 template <int W>
 void trace_wide(const WideBvh<W>& bvh, const Ray* rays, size_t n, Query query, Hit* hits,
                 TraversalCounters* counters = nullptr);
+// The same with the kernel compiled for `isa` (the others use traversal_isa()); throws
+// std::invalid_argument if the CPU does not run it. Every instruction set gives the same
+// hits, bit for bit.
+template <int W>
+void trace_wide(const WideBvh<W>& bvh, const Ray* rays, size_t n, Query query, Hit* hits, TraversalCounters* counters,
+                CpuIsa isa);
 
 struct WideEntry {
   uint32_t ref, count;  // as in WideNode: count 0 is an interior node

@@ -146,7 +146,7 @@ double Tracer::last_kernel_ms() const { return layouts_->bvh2_gpu ? layouts_->bv
 
 template <int W>
 size_t wide_bytes(const WideBvh<W>& b) {
-  return b.nodes.size() * sizeof(WideNode<W>) + b.packs.size() * sizeof(TrianglePack) + b.ids.size() * sizeof(PrimitiveId);
+  return b.nodes.size() * sizeof(WideNode<W>) + b.packs.size() * sizeof(TrianglePack);
 }
 
 size_t Tracer::layout_bytes() const {

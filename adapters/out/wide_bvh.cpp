@@ -41,7 +41,7 @@ uint32_t pack_leaf(WideBvh<W>& out, const BvhNode& n, const LeafTriangles& trian
         pack.v[1][axis][slot] = used ? t->b[axis] : nan;
         pack.v[2][axis][slot] = used ? t->c[axis] : nan;
       }
-      out.ids.push_back(used ? triangles.ids[n.first + i + slot] : PrimitiveId{kInvalidId, kInvalidId});
+      pack.id[slot] = used ? triangles.ids[n.first + i + slot] : PrimitiveId{kInvalidId, kInvalidId};
     }
     out.packs.push_back(pack);
   }
@@ -65,7 +65,6 @@ template <int W>
 WideBvh<W> make_wide_bvh(const Bvh& bvh, LeafTriangles triangles) {
   WideBvh<W> out;
   out.packs.reserve(bvh.prim_indices.size() / 2);
-  out.ids.reserve(bvh.prim_indices.size() * 2);
   if (bvh.empty() || (bvh.root().is_leaf() && bvh.root().count == 0)) return out;
   if (bvh.root().is_leaf()) {  // one leaf: a root with a single lane
     out.nodes.push_back(empty_node<W>());

@@ -2,10 +2,14 @@
 // all its children as structure-of-arrays (lo and hi per axis, W lanes each), so one ray
 // tests every child box with a handful of vector instructions. Unused lanes hold an empty
 // box (lo = +max, hi = -max), which the slab test never enters. A leaf's triangles are
-// packed eight at a time as structure-of-arrays (Embree's Triangle4, twice as wide), so one
-// ray tests eight triangles with the same vector instructions; unused slots hold never-hit
-// triangles. (Tried and not kept: child boxes quantised to 8 bits, two cache lines a node
-// instead of four: 10-30% slower here, the decoding costing more than the memory saved.)
+// packed four at a time as structure-of-arrays with their ids (Embree's Triangle4 block),
+// so one ray tests four triangles with the same vector instructions; unused slots hold
+// never-hit triangles.
+//
+// Tried and not kept: packs of eight (the leaves of SAH trees hold two or three
+// triangles, so such a pack is mostly empty and the leaves took twice the memory and the
+// cache lines); child boxes quantised to 8 bits, two cache lines a node instead of four
+// (10-30% slower here, the decoding costing more than the memory saved).
 #pragma once
 
 #include <cstdint>
@@ -24,18 +28,21 @@ struct alignas(64) WideNode {
   uint32_t count[W];  // 0 for an interior child; the leaf's triangle count otherwise
 };
 
-constexpr int kPackWidth = 8;
+constexpr int kPackWidth = 4;
 
-// kPackWidth triangles: v[vertex][axis][slot]. Slot s of pack p is triangle kPackWidth * p + s.
-struct alignas(32) TrianglePack {
+// kPackWidth triangles, v[vertex][axis][slot], with their ids: 176 bytes, Embree's
+// Triangle4 block, so the hit's ids are read from the lines its vertices came in on. Slot
+// s of pack p is triangle kPackWidth * p + s.
+struct alignas(16) TrianglePack {
   float v[3][3][kPackWidth];
+  PrimitiveId id[kPackWidth];  // {kInvalidId, kInvalidId} in unused slots
 };
+static_assert(sizeof(TrianglePack) == 176, "a pack is meant to take what Embree's Triangle4 takes");
 
 template <int W>
 struct WideBvh {
   std::vector<WideNode<W>> nodes;  // nodes[0] is the root; empty for an empty scene
   std::vector<TrianglePack> packs;
-  std::vector<PrimitiveId> ids;    // one per pack slot
   uint32_t stack_size = 1;  // bounds the traversal stack: (W - 1) per level, plus one
 };
 

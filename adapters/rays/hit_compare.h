@@ -1,4 +1,4 @@
-// The A/B oracle (DESIGN.md §6): the same rays answered by two systems, every difference
+// The A/B oracle (docs/design.md §6): the same rays answered by two systems, every difference
 // counted by kind. Where a ray passes within rounding of a triangle's edge or of an end of
 // its interval, the right answer depends on rounding and either system may be right: such
 // a difference is an edge tie, counted apart, when both answers are acceptable (see
@@ -32,7 +32,7 @@ struct RayMismatch {
 struct HitComparison {
   size_t rays = 0;
   size_t hits = 0;          // rays the reference answered with a hit
-  size_t skipped = 0;       // rays Embree must not be sent (invalid, DESIGN.md §7): both must miss
+  size_t skipped = 0;       // rays Embree must not be sent (invalid, docs/design.md §7): both must miss
   size_t hit_miss = 0;      // one system hit, the other missed
   size_t distance = 0;      // both hit, t differs beyond relative 1e-5
   size_t primitive = 0;     // both hit at the same t, different primitives, not a tie

@@ -11,7 +11,7 @@
 namespace kmbvh {
 namespace {
 
-// Counter-based streams of this file (DESIGN.md §3).
+// Counter-based streams of this file (docs/design.md §3).
 enum Stream : uint32_t { kJitterX = 101, kJitterY, kDiffuse1, kDiffuse2, kLightJitter };
 
 std::vector<Ray> primary_rays(const Aabb& bounds, size_t count, uint32_t seed) {

@@ -1,7 +1,7 @@
-// The rays `kmbvh trace` and the A/B tests send through both kmbvh and Embree (DESIGN.md
-// §6): primary rays from the scene's 3 views, shadow rays from their hit points toward a
-// light, and diffuse bounce rays from the same points, cosine-weighted, as a path tracer
-// makes them. Deterministic for a seed; made once and traced by every system.
+// The rays `kmbvh trace` and the A/B tests send through both kmbvh and Embree
+// (docs/design.md §6): primary rays from the scene's 3 views, shadow rays from their hit
+// points toward a light, and diffuse bounce rays from the same points, cosine-weighted, as
+// a path tracer makes them. Deterministic for a seed; made once and traced by every system.
 #pragma once
 
 #include <functional>

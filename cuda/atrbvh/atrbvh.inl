@@ -1,4 +1,4 @@
-// ATRBVH (Domingues and Pedrini 2015, DESIGN.md §5): the LBVH radix tree, restructured by
+// ATRBVH (Domingues and Pedrini 2015, docs/design.md §5): the LBVH radix tree, restructured by
 // agglomerative treelets (treelet_restructure.h) in `treelet_iterations` bottom-up passes,
 // then SAH leaf collapse. Portable: included by binary_builders_cpu.cpp and _gpu.cu, after
 // lbvh.inl.

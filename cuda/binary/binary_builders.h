@@ -1,5 +1,5 @@
 // The paper's reference builders that make a binary tree with one primitive per leaf and
-// then collapse leaves by SAH (DESIGN.md §5): LBVH, HLBVH, ATRBVH and PLOC. Portable like
+// then collapse leaves by SAH (docs/design.md §5): LBVH, HLBVH, ATRBVH and PLOC. Portable like
 // k-means: the same kernels on the CPU backend and, when built with nvcc, on the GPU.
 #pragma once
 

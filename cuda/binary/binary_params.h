@@ -10,7 +10,7 @@ namespace kmbvh {
 
 struct BinaryBuildParams {
   uint32_t max_leaf_size = 8;   // leaves collapsed by SAH up to this size (at most 32)
-  SahCosts sah{};               // k_T = 3, k_I = 2 (DESIGN.md §5)
+  SahCosts sah{};               // k_T = 3, k_I = 2 (docs/design.md §5)
   uint32_t ploc_radius = 16;    // PLOC: neighbours searched on each side
   uint32_t treelet_size = 9;    // ATRBVH: leaves of a restructured treelet
   uint32_t treelet_iterations = 2;  // ATRBVH: bottom-up restructuring passes

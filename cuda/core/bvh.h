@@ -1,4 +1,4 @@
-// What every builder produces (DESIGN.md §1): a topology over a PrimitiveSet. Nodes live in
+// What every builder produces (docs/design.md §1): a topology over a PrimitiveSet. Nodes live in
 // one array with the root first; the children of an interior node are contiguous
 // (first .. first + count - 1), so a binary node's children are a pair, and they come after
 // their parent in the array (so a tree has no cycles by construction). Leaves refer to a

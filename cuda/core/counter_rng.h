@@ -1,4 +1,4 @@
-// Counter-based randomness (DESIGN.md §3): every draw is a hash of (seed, stream, index),
+// Counter-based randomness (docs/design.md §3): every draw is a hash of (seed, stream, index),
 // never state shared between threads, so a build is identical for any thread count and
 // on both backends.
 #pragma once

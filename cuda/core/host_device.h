@@ -1,5 +1,5 @@
 // One macro for code that runs on both sides (the pbrt-v4 convention): kernel bodies are
-// written once, compiled by g++ for the CPU backend and by nvcc for the GPU (DESIGN.md §3).
+// written once, compiled by g++ for the CPU backend and by nvcc for the GPU (docs/design.md §3).
 #pragma once
 
 #if defined(__CUDACC__)

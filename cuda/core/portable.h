@@ -1,5 +1,5 @@
 // What every portable builder's level loop needs from Thrust, on either backend
-// (DESIGN.md §3). Included by a builder's .inl, which its _cpu.cpp and _gpu.cu wrappers
+// (docs/design.md §3). Included by a builder's .inl, which its _cpu.cpp and _gpu.cu wrappers
 // compile with KMBVH_BACKEND_NAMESPACE set (cpu_backend or gpu_backend) so the two
 // instantiations never collide; the CPU wrapper also sets KMBVH_BACKEND_CPU.
 #pragma once

@@ -1,4 +1,4 @@
-// What every builder consumes (DESIGN.md §1): one box per primitive and the primitive's
+// What every builder consumes (docs/design.md §1): one box per primitive and the primitive's
 // identity for the caller. Builders see only the boxes; a Bvh's leaves refer to positions
 // in this set, and adapters map positions back to ids.
 #pragma once

@@ -1,6 +1,6 @@
 // A parallel LSD radix sort of (64-bit key, 32-bit value) pairs for the CPU backend.
 // Thrust's OpenMP sort is a comparison sort that is slower on two threads than on one;
-// this one is linear (DESIGN.md §3: a hand-written CPU path where it is measurably faster,
+// this one is linear (docs/design.md §3: a hand-written CPU path where it is measurably faster,
 // tested against std::stable_sort). Stable, so equal keys keep their input order.
 #pragma once
 

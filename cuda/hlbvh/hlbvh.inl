@@ -1,4 +1,4 @@
-// HLBVH (Garanzha et al. 2011, DESIGN.md §5): the LBVH radix tree below the 15-bit Morton
+// HLBVH (Garanzha et al. 2011, docs/design.md §5): the LBVH radix tree below the 15-bit Morton
 // prefix, binned SAH over the prefix groups above it, then SAH leaf collapse. Portable:
 // included by binary_builders_cpu.cpp and _gpu.cu, after lbvh.inl.
 #pragma once

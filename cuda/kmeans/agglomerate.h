@@ -1,4 +1,4 @@
-// Agglomerative treelets (DESIGN.md §4 step 7): the children of a k-ary node are merged
+// Agglomerative treelets (docs/design.md §4 step 7): the children of a k-ary node are merged
 // pairwise, greedily, always the pair whose merged box has the smallest surface area
 // (Walter et al. 2008), which turns the k-ary node into a binary treelet. One work item per
 // k-ary node; naive pair search as the paper, with each slot's best partner cached.

@@ -1,4 +1,4 @@
-// The assignment step (DESIGN.md §4 step 3): each primitive joins its nearest representative.
+// The assignment step (docs/design.md §4 step 3): each primitive joins its nearest representative.
 // The kernel runs per piece (level.h): it assigns every primitive of the piece, gathers what
 // the next step needs in locals, and publishes it once per cluster.
 #pragma once

@@ -1,5 +1,5 @@
 // Distance between a primitive's box and a representative, both seen as 6-D points
-// (min corner, max corner) — DESIGN.md §4 step 1.
+// (min corner, max corner) — docs/design.md §4 step 1.
 #pragma once
 
 #include <cmath>

@@ -1,6 +1,6 @@
 // Output of a level: every split segment's non-empty clusters become its children, joined
 // by an agglomerative treelet (binary output) or attached directly (k-ary output). Small
-// clusters become leaves (DESIGN.md §4 step 5); the others become the next level's
+// clusters become leaves (docs/design.md §4 step 5); the others become the next level's
 // segments, with k = 2 once they hold fewer than m * k primitives.
 #pragma once
 

@@ -1,4 +1,4 @@
-// Initialisation of a node's k representatives (DESIGN.md §4 step 2): the first is a random
+// Initialisation of a node's k representatives (docs/design.md §4 step 2): the first is a random
 // primitive's box; each next one is, of p random primitives' boxes, the one farthest from
 // its nearest already chosen representative (a cheap k-means++-like spread).
 #pragma once

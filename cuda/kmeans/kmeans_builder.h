@@ -1,4 +1,4 @@
-// The k-means BVH builder (Meister and Bittner 2016), DESIGN.md §4: top-down k-means
+// The k-means BVH builder (Meister and Bittner 2016), docs/design.md §4: top-down k-means
 // clustering of primitive boxes, all nodes of a level together, then agglomerative
 // treelets that make each k-ary node binary (or, with KMeansParams::wide, the k-ary tree
 // itself). Runs on the CPU backend (Thrust over OpenMP) and, when built with nvcc, on the

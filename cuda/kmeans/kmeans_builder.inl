@@ -1,10 +1,10 @@
 // The level loop of the k-means builder, written once against Thrust and compiled twice
-// (DESIGN.md §3): by g++ with Thrust's OpenMP device system (kmeans_builder_cpu.cpp) and
+// (docs/design.md §3): by g++ with Thrust's OpenMP device system (kmeans_builder_cpu.cpp) and
 // by nvcc for the GPU (kmeans_builder_gpu.cu). The including file defines
 // KMBVH_BACKEND_NAMESPACE (so the two instantiations never collide) and
 // KMBVH_PIECE_SIZE (primitives per work item of the per-primitive kernels).
 //
-// Per level (DESIGN.md §4): set up the segments' clusters and pieces, initialise the
+// Per level (docs/design.md §4): set up the segments' clusters and pieces, initialise the
 // representatives, run i Lloyd iterations (assign, update), assign once more, partition
 // each segment by cluster, and emit the children: leaves, treelet nodes and the next
 // level's segments.

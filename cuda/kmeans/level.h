@@ -1,5 +1,5 @@
 // The state of one level of the top-down build: all nodes being split at this level are
-// processed together (DESIGN.md §4). A node being split is a Segment, a contiguous range
+// processed together (docs/design.md §4). A node being split is a Segment, a contiguous range
 // of the level's primitive arrays. Each segment is cut into Pieces of bounded size: a piece
 // is the work item of the per-primitive kernels, which keep per-cluster sums in locals and
 // publish them once per piece (the paper's fixed-point atomics, one per piece and cluster

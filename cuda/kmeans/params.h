@@ -1,4 +1,4 @@
-// Parameters of the k-means builder (DESIGN.md §4) and the paper's presets Q1-Q5.
+// Parameters of the k-means builder (docs/design.md §4) and the paper's presets Q1-Q5.
 #pragma once
 
 #include <cstdint>

@@ -1,4 +1,4 @@
-// Partition of each node's primitive range by cluster (DESIGN.md §4 steps 4 and 6): a
+// Partition of each node's primitive range by cluster (docs/design.md §4 steps 4 and 6): a
 // counting sort per segment. Counts come per piece from the assignment; PlaceClusters turns
 // them into write cursors (cluster-major, then piece order, so the partition is stable and
 // the same for any thread count); ScatterPiece moves the primitives.
@@ -10,7 +10,7 @@
 
 namespace kmbvh {
 
-// The guaranteed split (DESIGN.md §4 step 6): when representatives coincide (identical or
+// The guaranteed split (docs/design.md §4 step 6): when representatives coincide (identical or
 // duplicated boxes), every primitive can land in one cluster and the node would never get
 // smaller. Such a segment is flagged and its clusters cleared; the SplitByIndex assignment
 // pass then deals its primitives into k runs by position, which always gives at least two

@@ -1,4 +1,4 @@
-// A hand-written CPU path for the bottom of the tree (DESIGN.md §3: where a CPU path is
+// A hand-written CPU path for the bottom of the tree (docs/design.md §3: where a CPU path is
 // measurably faster than the generic one, keep both). Once a node holds at most one piece
 // of primitives, the level loop would still stream the whole level's arrays through every
 // pass for it; here one work item splits the node's entire subtree depth-first instead,

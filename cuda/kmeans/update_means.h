@@ -1,4 +1,4 @@
-// The mean update of the Lloyd loop (DESIGN.md §4 step 3): a representative becomes the mean
+// The mean update of the Lloyd loop (docs/design.md §4 step 3): a representative becomes the mean
 // of its members' min corners and the mean of their max corners.
 //
 // Sums are fixed-point integers, as in the paper: coordinates are taken relative to the

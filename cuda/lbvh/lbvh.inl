@@ -1,4 +1,4 @@
-// LBVH (Karras 2012, DESIGN.md §5): primitives in 60-bit Morton order, the binary radix
+// LBVH (Karras 2012, docs/design.md §5): primitives in 60-bit Morton order, the binary radix
 // tree over the sorted codes built bottom-up with boxes, costs and collapse decisions on
 // the way (radix_tree.h, collapse.h), leaves collapsed by SAH up to the max leaf size.
 // Portable: included by binary_builders_cpu.cpp and _gpu.cu.

@@ -1,4 +1,4 @@
-// Surface area heuristic cost of a finished tree (DESIGN.md §6):
+// Surface area heuristic cost of a finished tree (docs/design.md §6):
 //   (k_T * sum over interior nodes SA(n) + k_I * sum over leaves |leaf| * SA(leaf)) / SA(root)
 #pragma once
 

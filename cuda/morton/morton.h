@@ -1,5 +1,5 @@
 // 60-bit Morton codes (20 bits per axis) of primitive centroids, the order LBVH, HLBVH and
-// PLOC start from (DESIGN.md §5).
+// PLOC start from (docs/design.md §5).
 #pragma once
 
 #include <cstdint>

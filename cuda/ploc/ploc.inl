@@ -1,4 +1,4 @@
-// PLOC (Meister and Bittner 2018, DESIGN.md §5): bottom-up clustering in Morton order,
+// PLOC (Meister and Bittner 2018, docs/design.md §5): bottom-up clustering in Morton order,
 // iterations of ploc_steps.h until one cluster is left, then SAH leaf collapse. Portable:
 // included by binary_builders_cpu.cpp and _gpu.cu.
 #pragma once

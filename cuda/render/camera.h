@@ -1,5 +1,5 @@
 // A pinhole camera, and the views of a scene derived from its bounds when the scene brings
-// none (DESIGN.md §6: 3 views per scene). Portable, so a GPU renderer makes the same rays.
+// none (docs/design.md §6: 3 views per scene). Portable, so a GPU renderer makes the same rays.
 #pragma once
 
 #include <cmath>

@@ -1,11 +1,11 @@
-// The path tracer's per-path kernels (DESIGN.md §6): a wavefront of paths, one
+// The path tracer's per-path kernels (docs/design.md §6): a wavefront of paths, one
 // work item per path, written once for the CPU and the GPU. Paths are diffuse: at each hit
 // the path adds the surface's emission, sends `shadow_samples` shadow rays to the area
 // light (next-event estimation), and continues in a cosine-weighted direction, ended by
 // Russian roulette from `roulette_depth` surfaces on. The light is reached only through
 // shadow rays and the sky only by escaping, so no light is counted twice.
 //
-// Randomness is counter-based (DESIGN.md §3): draw `dim` at `depth` of the path of `pixel`
+// Randomness is counter-based (docs/design.md §3): draw `dim` at `depth` of the path of `pixel`
 // in sample pass `key` (a hash of seed, view and pass). An image is then the same for any
 // thread count, wave size and traversal that reports the same triangles.
 #pragma once
@@ -44,7 +44,7 @@ KMBVH_HD KMBVH_INLINE float path_draw(uint32_t key, uint32_t depth, uint32_t dim
 struct PathLimits {
   uint32_t max_depth = 32;      // surfaces a path may hit (a bound for termination, rarely reached)
   uint32_t roulette_depth = 3;  // surfaces hit before Russian roulette starts
-  uint32_t shadow_samples = 2;  // shadow rays per hit (DESIGN.md §6: 2), at most kMaxShadowSamples
+  uint32_t shadow_samples = 2;  // shadow rays per hit (docs/design.md §6: 2), at most kMaxShadowSamples
 };
 
 // The scene as the shading kernel reads it: plain pointers on the backend's side.

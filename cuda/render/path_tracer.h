@@ -21,7 +21,7 @@ namespace kmbvh {
 using TraceBatch = std::function<void(const Ray* rays, size_t n, Query query, Hit* hits)>;
 
 struct RenderSettings {
-  uint32_t width = 1024, height = 768;  // DESIGN.md §6
+  uint32_t width = 1024, height = 768;  // docs/design.md §6
   uint32_t spp = 8;                     // samples per pixel: 8 (LQ) or 128 (HQ)
   uint32_t seed = 1;
   PathLimits limits;

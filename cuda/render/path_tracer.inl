@@ -1,5 +1,5 @@
 // The wavefront loop of the path tracer, written once against Thrust and compiled twice
-// (DESIGN.md §3): path_tracer_cpu.cpp (g++, Thrust's OpenMP system) and path_tracer_gpu.cu
+// (docs/design.md §3): path_tracer_cpu.cpp (g++, Thrust's OpenMP system) and path_tracer_gpu.cu
 // (nvcc). Per sample pass and per wave of at most settings.wave pixels:
 //   start one path per pixel; then while paths live: gather their rays, trace them
 //   (closest hit), shade (path_kernels.h), pack the shadow rays that exist, trace them

@@ -1,4 +1,4 @@
-// Full sweep SAH (DESIGN.md §5), the normalisation reference: top-down, at every node the
+// Full sweep SAH (docs/design.md §5), the normalisation reference: top-down, at every node the
 // cheapest of all splits of the primitives sorted by centroid on each of the three axes,
 // or a leaf when that is no dearer. Exact (no binning), O(n log n): the three orders are
 // sorted once and partitioned stably at every split. CPU only; parallel over the nodes of

@@ -28,7 +28,7 @@ struct Hit {
   KMBVH_HD bool found() const { return geomID != kInvalidId; }
 };
 
-// What kmbvh answers for rays Embree rejects with an assertion (DESIGN.md §7): a NaN or
+// What kmbvh answers for rays Embree rejects with an assertion (docs/design.md §7): a NaN or
 // infinite origin or direction, a negative or NaN tnear, a NaN tfar. Such rays never hit
 // anything; they never crash or loop either. An interval with tnear > tfar, or a zero
 // direction, is valid and simply misses, as in Embree.

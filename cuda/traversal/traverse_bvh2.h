@@ -1,7 +1,7 @@
 // One ray through a Bvh2: the while-while loop of Aila and Laine (2009). The inner loop
 // walks interior nodes, entering the nearer child and pushing the farther one, until it
 // reaches a leaf; the second loop intersects leaves until the next interior node comes
-// off the stack. Written once for the CPU and the GPU (DESIGN.md §3).
+// off the stack. Written once for the CPU and the GPU (docs/design.md §3).
 //
 // The stack grows by at most one entry per level (only the farther child of a node is
 // pushed), so the layout's stack_size, the depth of the tree plus one, always suffices:
@@ -19,13 +19,13 @@ struct TraversalEntry {
   float entry;          // where the ray enters its box: skipped once a closer hit is known
 };
 
-// The hit on triangle `found`, its t, u, v and Ng measured again in double precision
-// unless `refine` is false: an occlusion query needs only the yes (as Embree's reports).
-KMBVH_HD KMBVH_INLINE bool finish_bvh2_hit(const Bvh2View& view, const Ray& ray, uint32_t found, Hit& hit,
+// The hit on triangle `found`, with t, u, v and Ng from its exact check (`check`) unless
+// `refine` is false: an occlusion query needs only the yes (as Embree's reports).
+KMBVH_HD KMBVH_INLINE bool finish_bvh2_hit(const Bvh2View& view, uint32_t found, const ExactCheck& check, Hit& hit,
                                            bool refine = true) {
   if (found == kInvalidId) return false;
   const LeafTriangle& tri = view.triangles[found];
-  if (refine) refine_hit(ray, tri.a, tri.b, tri.c, hit);
+  if (refine) apply_exact_check(check, tri.a, tri.b, tri.c, hit);
   hit.geomID = view.ids[found].geom;
   hit.primID = view.ids[found].prim;
   return true;
@@ -42,6 +42,7 @@ KMBVH_HD KMBVH_INLINE bool trace_bvh2(const Bvh2View& view, const Ray& ray, Quer
   const RayShear shear(ray);
   float tmax = ray.tfar;
   uint32_t found = kInvalidId;  // the closest hit's triangle so far
+  ExactCheck check;             // and its exact check
   uint32_t sp = 0;
   TraversalEntry cur{0, 0, ray.tnear};
   for (;;) {
@@ -59,7 +60,7 @@ KMBVH_HD KMBVH_INLINE bool trace_bvh2(const Bvh2View& view, const Ray& ray, Quer
         cur = TraversalEntry{n.ref[c], n.count[c], c ? e1 : e0};
       } else {
         do {
-          if (sp == 0) return finish_bvh2_hit(view, ray, found, hit);
+          if (sp == 0) return finish_bvh2_hit(view, found, check, hit);
           cur = stack[--sp];
         } while (cur.entry > tmax);
       }
@@ -67,15 +68,19 @@ KMBVH_HD KMBVH_INLINE bool trace_bvh2(const Bvh2View& view, const Ray& ray, Quer
     while (cur.count != 0) {  // leaves
       for (uint32_t i = cur.ref; i < cur.ref + cur.count; ++i) {
         const LeafTriangle& tri = view.triangles[i];
-        if (!intersect_watertight(shear, ray.tnear, tmax, tri.a, tri.b, tri.c, hit)) continue;
-        if (!exact_t_within(ray, tri.a, tri.b, tri.c, ray.tnear, tmax)) continue;
+        Hit candidate;
+        if (!intersect_watertight(shear, ray.tnear, tmax, tri.a, tri.b, tri.c, candidate)) continue;
+        const ExactCheck exact = exact_check(ray, tri.a, tri.b, tri.c, ray.tnear, tmax);
+        if (!exact.within) continue;
         found = i;
+        check = exact;
+        hit = candidate;
         if (query == Query::Any) break;
         tmax = hit.t;
       }
-      if (query == Query::Any && found != kInvalidId) return finish_bvh2_hit(view, ray, found, hit, false);
+      if (query == Query::Any && found != kInvalidId) return finish_bvh2_hit(view, found, check, hit, false);
       do {
-        if (sp == 0) return finish_bvh2_hit(view, ray, found, hit);
+        if (sp == 0) return finish_bvh2_hit(view, found, check, hit);
         cur = stack[--sp];
       } while (cur.entry > tmax);
     }

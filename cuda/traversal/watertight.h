@@ -32,6 +32,14 @@ struct RayShear {
     sx = ray.dir[kx] * sz;
     sy = ray.dir[ky] * sz;
   }
+
+  // The same from axes and 1 / dir[kz] found elsewhere (the wide traversal's set-up, which
+  // makes all of a ray's reciprocals in one vector division).
+  KMBVH_HD RayShear(const Ray& ray, int x, int y, int z, float inverse_dir_z)
+      : org(ray.org), kx(x), ky(y), kz(z), sz(inverse_dir_z) {
+    sx = ray.dir[kx] * sz;
+    sy = ray.dir[ky] * sz;
+  }
 };
 
 // A triangle Embree never hits: its geometric normal, computed in float, is exactly zero
@@ -107,32 +115,54 @@ KMBVH_HD KMBVH_INLINE bool exact_hit(const Ray& ray, Vec3 a, const ExactEdges& e
   return true;
 }
 
+// What the double-precision measure of one candidate hit says: whether its t lies in
+// (tnear, tmax], and the t, u and v the hit then reports (refine_hit).
+struct ExactCheck {
+  bool within = true;     // in the interval by the exact distance too
+  bool measured = false;  // false: the ray is parallel to the plane in double; the float test decides
+  float t = 0.0f, u = 0.0f, v = 0.0f;
+};
+
 // Whether a hit the float test accepted lies in (tnear, tmax] by the exact distance too.
 // The float test decides on which side of each edge the ray passes (that keeps it
 // watertight), but on a needle triangle (nearly collinear vertices) the plane is so
 // ill-conditioned that its float t can land on the wrong side of the origin: a secondary
 // ray leaving a needle then hits the needle itself, behind it. Checked on accepted hits
-// only, a few per ray.
-KMBVH_HD KMBVH_INLINE bool exact_t_within(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, float tnear, float tmax) {
+// only, a few per ray; the same measure gives the hit's refined t, u and v, so the hit
+// that stands is not measured twice.
+KMBVH_HD KMBVH_INLINE ExactCheck exact_check(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, float tnear, float tmax) {
+  ExactCheck check;
   double t, u, v;
-  if (!exact_hit(ray, a, ExactEdges(a, b, c), t, u, v)) return true;  // parallel in double: the float test decides
-  return t > double(tnear) && t <= double(tmax);
+  if (!exact_hit(ray, a, ExactEdges(a, b, c), t, u, v)) return check;
+  check.within = t > double(tnear) && t <= double(tmax);
+  check.measured = true;
+  check.t = float(t);
+  check.u = float(u);
+  check.v = float(v);
+  return check;
+}
+
+KMBVH_HD KMBVH_INLINE bool exact_t_within(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, float tnear, float tmax) {
+  return exact_check(ray, a, b, c, tnear, tmax).within;
 }
 
 // The watertight test decides hit or miss, but its sheared, origin-relative coordinates
 // lose digits of t, u and v when the triangle is thin and seen almost edge-on from far
 // away (a wall across a room: u off by 1e-3 in float, by any float method; Embree's too).
-// So the closest hit, once known, is measured again from the triangle's own edges in
-// double precision: one more test per ray, and t, u, v and Ng correct to float precision.
-KMBVH_HD KMBVH_INLINE void refine_hit(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, Hit& hit) {
-  const ExactEdges edges(a, b, c);
-  double t, u, v;
-  if (!exact_hit(ray, a, edges, t, u, v)) return;
-  hit.u = float(u);
-  hit.v = float(v);
-  hit.t = float(t);
+// So the closest hit, once known, reports t, u, v and Ng measured from the triangle's own
+// edges in double precision: t, u, v and Ng correct to float precision. `check` is that
+// triangle's exact_check, made when it was accepted.
+KMBVH_HD KMBVH_INLINE void apply_exact_check(const ExactCheck& check, Vec3 a, Vec3 b, Vec3 c, Hit& hit) {
+  if (!check.measured) return;
+  hit.u = check.u;
+  hit.v = check.v;
+  hit.t = check.t;
   // The normal too: in float, the cross product of a needle's edges cancels catastrophically.
-  hit.Ng = edges.normal();
+  hit.Ng = ExactEdges(a, b, c).normal();
+}
+
+KMBVH_HD KMBVH_INLINE void refine_hit(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, Hit& hit) {
+  apply_exact_check(exact_check(ray, a, b, c, 0.0f, 0.0f), a, b, c, hit);
 }
 
 }  // namespace kmbvh

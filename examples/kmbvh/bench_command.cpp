@@ -1,5 +1,5 @@
 // kmbvh bench [SCENES...]: every chosen builder on every scene in one process, so build
-// times can be compared as ratios measured in the same run (DESIGN.md §6). Two suites
+// times can be compared as ratios measured in the same run (docs/design.md §6). Two suites
 // besides: --suite paper (time to image with the path tracer, paper_suite.cpp) and
 // --suite iterations (SAH cost against k-means' Lloyd iterations for several k, the
 // paper's stabilisation figure).

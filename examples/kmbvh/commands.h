@@ -47,7 +47,7 @@ struct BuildCommand {
 // kmbvh render [SCENE]: the path tracer over one builder's tree, or Embree's.
 struct RenderOptions {
   std::string layout = "bvh8";
-  std::string quality = "lq";  // lq: 8 samples per pixel, hq: 128 (DESIGN.md §6)
+  std::string quality = "lq";  // lq: 8 samples per pixel, hq: 128 (docs/design.md §6)
   uint32_t spp = 0;            // overrides the quality's
   uint32_t width = 1024, height = 768;
   uint32_t seed = 1;

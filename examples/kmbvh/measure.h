@@ -1,4 +1,4 @@
-// Running one builder on one scene the way DESIGN.md §6 measures: a first run that
+// Running one builder on one scene the way docs/design.md §6 measures: a first run that
 // measures the build's memory (from a trimmed heap), warm-up, several timed runs in the
 // allocator's steady state (median reported), then the full validation of the tree.
 #pragma once

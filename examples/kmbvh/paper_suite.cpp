@@ -1,4 +1,4 @@
-// kmbvh bench --suite paper: the paper's evaluation on this machine (DESIGN.md §6).
+// kmbvh bench --suite paper: the paper's evaluation on this machine (docs/design.md §6).
 // For every scene and system (each builder's tree in kmbvh's traversal, and Embree's own
 // scene and traversal end to end): the build, its SAH cost, the path tracer's rays per
 // second and the time to image, LQ (8 samples per pixel) and HQ (128), each time being the

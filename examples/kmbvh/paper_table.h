@@ -1,4 +1,4 @@
-// The paper's Table 1 (Meister and Bittner 2016; DESIGN.md §4) for the scenes kmbvh has:
+// The paper's Table 1 (Meister and Bittner 2016; docs/design.md §4) for the scenes kmbvh has:
 // SAH cost, Mrays/s and build time (GPU) per builder, to print beside kmbvh's figures.
 #pragma once
 

@@ -1,6 +1,6 @@
 // kmbvh render [SCENE] --builder B --layout L | --traversal embree: the scene's views through
 // the path tracer, written as PNG (to look at) and EXR (to compare), with the
-// build, layout and render times and the time to image they add up to (DESIGN.md §6).
+// build, layout and render times and the time to image they add up to (docs/design.md §6).
 #include <fmt/format.h>
 
 #include <filesystem>

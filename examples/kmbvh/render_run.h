@@ -56,7 +56,7 @@ class PreparedSystem {
   TraceBatch batches_;
 };
 
-// The mean over views of their render times: what DESIGN.md §6 averages over 3 views.
+// The mean over views of their render times: what docs/design.md §6 averages over 3 views.
 double mean_render_ms(const std::vector<ViewRender>& views);
 
 }  // namespace kmbvh

@@ -1,13 +1,15 @@
 // kmbvh trace SCENE --builder B --layout L --rays K --count N --compare-embree: the same
 // rays through kmbvh's traversal over B's tree and through Embree's own scene, every
-// difference counted, and the speed of both (DESIGN.md §6).
+// difference counted, and the speed of both (docs/design.md §6).
 #include <fmt/format.h>
 
 #include <chrono>
+#include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
 
 #include "adapters/embree/embree_scene.h"
+#include "adapters/out/cpu_isa.h"
 #include "adapters/out/tracer.h"
 #include "adapters/rays/hit_compare.h"
 #include "adapters/rays/scene_rays.h"
@@ -54,15 +56,41 @@ double median_seconds(int runs, int warmup, const F& f) {
 
 double mrays(size_t rays, double seconds) { return seconds > 0 ? double(rays) / seconds * 1e-6 : 0.0; }
 
+double seconds_of(const std::function<void()>& f) {
+  const auto start = std::chrono::steady_clock::now();
+  f();
+  return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
+}
+
+// `ours` and `theirs` timed in turn, `runs` times after `warmup` untimed pairs: the load of
+// a shared machine moves both alike within a pair, so the median of the pairs' ratios
+// (their time over ours) holds still where two medians taken apart move by 10-20%.
+struct PairedTimes {
+  double ours_seconds = 0, theirs_seconds = 0;  // medians
+  double ratio = 0;
+};
+PairedTimes time_in_pairs(int runs, int warmup, const std::function<void()>& ours, const std::function<void()>& theirs) {
+  for (int i = 0; i < warmup; ++i) ours(), theirs();
+  std::vector<double> a, b, ratios;
+  for (int i = 0; i < runs; ++i) {
+    a.push_back(seconds_of(ours));
+    b.push_back(seconds_of(theirs));
+    ratios.push_back(a.back() > 0 ? b.back() / a.back() : 0.0);
+  }
+  return PairedTimes{median(a), median(b), median(ratios)};
+}
+
 struct EmbreeResult {
   std::vector<Hit> hits;  // rtcIntersect1 / rtcOccluded1
-  double single_mrays = 0, packet_mrays = 0;
+  double packet_mrays = 0;  // rtcIntersect16 / rtcOccluded16 (rtc*1 is timed in pairs with kmbvh's: KindResult)
 };
 
 struct KindResult {
   RayKind kind = RayKind::Primary;
   size_t rays = 0;
   double mrays = 0;
+  double embree_mrays = 0;  // Embree's rtcIntersect1/rtcOccluded1, timed in pairs with ours
+  double ratio = 0;         // the median of the pairs' ratios
   double kernel_mrays = 0;  // GPU: the kernel alone, transfers excluded
   const EmbreeResult* embree = nullptr;
   HitComparison comparison;
@@ -144,6 +172,8 @@ int run_trace(const TraceCommand& c) {
   const BuilderConfig config = builder_config(c.builder, c.run);
   const std::vector<Layout> layouts = parse_layouts(c.layouts);
   const std::vector<RayKind> kinds = parse_kinds(c.rays);
+  for (const Layout layout : layouts)
+    if (layout != Layout::Bvh2) traversal_isa();  // a KMBVH_ISA this CPU cannot run fails now, not after the build
   Progress progress(c.run.quiet);
   progress.update(fmt::format("loading {}", c.scene.empty() ? "the default scene" : c.scene));
   const LoadedScene scene = load_scene_argument(c.scene);
@@ -165,9 +195,7 @@ int run_trace(const TraceCommand& c) {
       EmbreeResult& e = embree_results[int(kind)];
       const std::vector<Ray>& set = rays.of(kind);
       std::vector<Hit> packet_hits;
-      e.single_mrays = mrays(set.size(), median_seconds(c.run.runs, c.run.warmup, [&] {
-                               embree->trace(set, query_for(kind), EmbreeRays::Single, e.hits);
-                             }));
+      embree->trace(set, query_for(kind), EmbreeRays::Single, e.hits);
       e.packet_mrays = mrays(set.size(), median_seconds(c.run.runs, c.run.warmup, [&] {
                                embree->trace(set, query_for(kind), EmbreeRays::Packet16, packet_hits);
                              }));
@@ -198,12 +226,22 @@ int run_trace(const TraceCommand& c) {
       KindResult r;
       r.kind = kind;
       r.rays = rays.of(kind).size();
-      std::vector<Hit> hits;
+      std::vector<Hit> hits, embree_hits;
       std::vector<double> kernel_ms;
-      r.mrays = mrays(r.rays, median_seconds(c.run.runs, c.run.warmup, [&] {
-                        tracer.trace(rays.of(kind), query_for(kind), hits);
-                        kernel_ms.push_back(tracer.last_kernel_ms());
-                      }));
+      const auto ours = [&] {
+        tracer.trace(rays.of(kind), query_for(kind), hits);
+        kernel_ms.push_back(tracer.last_kernel_ms());
+      };
+      if (embree) {
+        const PairedTimes t = time_in_pairs(c.run.runs, c.run.warmup, ours, [&] {
+          embree->trace(rays.of(kind), query_for(kind), EmbreeRays::Single, embree_hits);
+        });
+        r.mrays = mrays(r.rays, t.ours_seconds);
+        r.embree_mrays = mrays(r.rays, t.theirs_seconds);
+        r.ratio = t.ratio;
+      } else {
+        r.mrays = mrays(r.rays, median_seconds(c.run.runs, c.run.warmup, ours));
+      }
       r.kernel_mrays = mrays(r.rays, median(kernel_ms) * 1e-3);
       r.counters = tracer.count(rays.of(kind), query_for(kind));
       if (embree) {
@@ -221,23 +259,26 @@ int run_trace(const TraceCommand& c) {
         if (r.kernel_mrays > 0) k["kmbvh_kernel_mrays_per_s"] = r.kernel_mrays;
         if (r.counters) k["counters"] = counters_json(*r.counters);
         if (r.embree) {
-          k["embree_mrays_per_s"] = r.embree->single_mrays;
+          k["embree_mrays_per_s"] = r.embree_mrays;
           k["embree16_mrays_per_s"] = r.embree->packet_mrays;
-          k["ratio_to_embree"] = r.embree->single_mrays > 0 ? r.mrays / r.embree->single_mrays : 0.0;
+          k["ratio_to_embree"] = r.ratio;
           k["comparison"] = comparison_json(r.comparison);
         }
         kinds_json.push_back(k);
       }
-      layout_rows.push_back(Json{{"layout", to_string(layout)}, {"collapsed", tracer.collapsed()},
+      layout_rows.push_back(Json{{"layout", to_string(layout)},
+                                 {"isa", layout == Layout::Bvh2 ? "portable" : to_string(traversal_isa())},
+                                 {"collapsed", tracer.collapsed()},
                                  {"traced_sah_cost", traced_sah}, {"layout_ms", tracer.layout_ms()},
                                  {"layout_bytes", tracer.layout_bytes()}, {"stack_size", tracer.stack_size()},
                                  {"kinds", kinds_json}});
       continue;
     }
     progress.done();
-    fmt::print("\n{} layout{} · SAH of the traced tree {:.1f} · {:.1f} MB · laid out in {:.1f} ms\n", to_string(layout),
+    fmt::print("\n{} layout{} · SAH of the traced tree {:.1f} · {:.1f} MB · laid out in {:.1f} ms{}\n", to_string(layout),
                tracer.collapsed() ? " (collapsed by SAH from the binary tree)" : "", traced_sah,
-               double(tracer.layout_bytes()) / (1 << 20), tracer.layout_ms());
+               double(tracer.layout_bytes()) / (1 << 20), tracer.layout_ms(),
+               layout == Layout::Bvh2 ? "" : fmt::format(" · {} kernel", to_string(traversal_isa())));
     fmt::print("{:<8} {:>8} {:>13} {:>13} {:>7} {:>13} {:>10} {:>9}\n", "rays", "count", "kmbvh Mrays/s", "rtc*1 Mrays/s",
                "ratio", "rtc*16 Mrays/s", "mismatch", "edge ties");
     for (const KindResult& r : results) {
@@ -248,7 +289,7 @@ int run_trace(const TraceCommand& c) {
         continue;
       }
       fmt::print("{:<8} {:>8} {:>13.2f} {:>13.2f} {:>7.2f} {:>13.2f} {:>10} {:>9}\n", to_string(r.kind), r.rays, r.mrays,
-                 r.embree->single_mrays, r.embree->single_mrays > 0 ? r.mrays / r.embree->single_mrays : 0.0,
+                 r.embree_mrays, r.ratio,
                  r.embree->packet_mrays, r.comparison.mismatches(), r.comparison.edge_ties);
       print_kernel_rate(r);
       print_counters(r);

@@ -3,6 +3,7 @@
 #include <chrono>
 
 #include "adapters/builder_registry.h"
+#include "adapters/out/cpu_isa.h"
 #include "cuda/metrics/sah.h"
 #include "plugin/plugin_config.h"
 #include "plugin/real_embree.h"
@@ -67,6 +68,7 @@ SceneAccel::SceneAccel(const std::vector<EmbreeTriangleMesh>& meshes, std::vecto
   report.meshes = meshes.size();
   report.dropped = flat.dropped;
   report.triangles = flat.scene.triangles.size();
+  report.isa = to_string(traversal_isa());  // a KMBVH_ISA this CPU cannot run fails here, before the build
   if (flat.scene.triangles.empty()) return;  // every ray misses
   const PrimitiveSet prims = make_primitive_set(flat.scene);
   const Bvh bvh = run_builder(config, prims);

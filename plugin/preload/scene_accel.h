@@ -20,6 +20,7 @@ struct AccelReport {
   size_t triangles = 0, meshes = 0, dropped = 0;
   double build_ms = 0, layout_ms = 0;
   double sah = 0;
+  std::string isa;  // the traversal kernel's instruction set (adapters/out/cpu_isa.h)
 };
 
 // An application's filter functions on one geometry, called as Embree calls them: with

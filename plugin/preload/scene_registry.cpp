@@ -444,11 +444,11 @@ void commit_or_build(RTCScene scene, bool join) {
     return commit_by_embree(scene, *s, join, std::string("kmbvh could not build it: ") + e.what(), instanced);
   }
   if (plugin_config().log)
-    log_line(fmt::format("scene {}: {}, {} triangles in {} meshes{}{}, build {:.1f} ms + layout {:.1f} ms, SAH {:.2f}{}",
+    log_line(fmt::format("scene {}: {}, {} triangles in {} meshes{}{}, build {:.1f} ms + layout {:.1f} ms ({} kernel), SAH {:.2f}{}",
                          static_cast<void*>(scene), report.builder, report.triangles, report.meshes,
                          report.dropped ? fmt::format(" ({} dropped as Embree drops them)", report.dropped) : "",
                          accel->has_filters(Query::Closest) || accel->has_filters(Query::Any) ? " with filter functions" : "",
-                         report.build_ms, report.layout_ms, report.sah,
+                         report.build_ms, report.layout_ms, report.isa, report.sah,
                          embree_too ? "; Embree builds it too (instanced)" : "; Embree's build deferred"));
   {
     std::lock_guard<std::mutex> lock(registry().mutex);

@@ -1,0 +1,7 @@
+#include "kmbvh.h"
+
+namespace kmbvh {
+
+const char* library_version() { return KMBVH_VERSION; }
+
+}  // namespace kmbvh

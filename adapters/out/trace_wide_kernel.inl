@@ -1,0 +1,425 @@
+// The wide traversal's kernel: included by trace_wide.cpp once per instruction set, each
+// time inside its own namespace and `#pragma GCC target` region, with kAvx defined (whether
+// the region has AVX). Everything here is compiled for that region's instruction set;
+// what it calls from outside (watertight.h, the standard library) is compiled for the
+// file's and inlined, which a wider instruction set allows.
+//
+// Rays through a 4- or 8-wide layout on the CPU: every child box of a node in one SIMD
+// slab test, then the entered children ordered by distance, nearest first; a leaf's packs
+// of four triangles in one watertight test each (cuda/traversal/watertight.h, the same
+// operations as the scalar test, so every layout and every instruction set gives the
+// same answer bit for bit).
+
+typedef float vf4 __attribute__((vector_size(16)));
+typedef float vf8 __attribute__((vector_size(32)));
+typedef int vi4 __attribute__((vector_size(16)));
+typedef int vi8 __attribute__((vector_size(32)));
+
+// W lanes of floats, for nodes of W children and packs of W triangles.
+template <int W>
+struct Lanes;
+template <>
+struct Lanes<4> {
+  using V = vf4;
+};
+template <>
+struct Lanes<8> {
+  using V = vf8;
+};
+using vfp = Lanes<kPackWidth>::V;  // a pack's lanes
+using vip = std::conditional_t<kPackWidth == 8, vi8, vi4>;
+
+template <typename V>
+inline V vmin(V a, V b) {
+  return b < a ? b : a;
+}
+template <typename V>
+inline V vmax(V a, V b) {
+  return a < b ? b : a;
+}
+
+// One bit per lane of a comparison's result. (The ISA macros such as __AVX__ describe the
+// file's flags, not the target of the region this kernel is compiled in: kAvx does.)
+inline unsigned mask_bits(vi4 m) { return unsigned(_mm_movemask_ps(__m128(m))); }
+inline unsigned mask_bits(vi8 m) {
+  if constexpr (kAvx) {
+    return unsigned(_mm256_movemask_ps(__m256(m)));
+  } else {  // two halves of four
+    vi4 lo, hi;
+    __builtin_memcpy(&lo, &m, sizeof(lo));
+    __builtin_memcpy(&hi, reinterpret_cast<const char*>(&m) + sizeof(lo), sizeof(hi));
+    return mask_bits(lo) | mask_bits(hi) << 4;
+  }
+}
+
+// An aligned load: node planes and pack slots start on a multiple of the lanes' width.
+template <int W>
+inline typename Lanes<W>::V load(const float* p) {
+  return *reinterpret_cast<const typename Lanes<W>::V*>(__builtin_assume_aligned(p, sizeof(float) * W));
+}
+
+// Every lane set to x (one broadcast; `V{} + x` would add zero first, which the compiler
+// may not fold away because of -0).
+template <typename V>
+inline V splat(float x);
+template <>
+inline vf4 splat<vf4>(float x) {
+  return vf4{x, x, x, x};
+}
+template <>
+inline vf8 splat<vf8>(float x) {
+  return vf8{x, x, x, x, x, x, x, x};
+}
+
+// a where mask is set, b elsewhere (SSE2: no blend instruction needed).
+inline __m128 select4(__m128 mask, __m128 a, __m128 b) {
+  return _mm_or_ps(_mm_and_ps(mask, a), _mm_andnot_ps(mask, b));
+}
+
+// The per-ray set-up of the slab test and the shear (RayBoxSetup, RayShear) with a single
+// division for all four reciprocals: RayBoxSetup's safe inverse of the direction in lanes
+// 0-2, the shear's 1 / dir[kz] in lane 3. The same values, bit for bit, in SSE2.
+struct RaySetup {
+  float inv[4];  // 1 / safe(dir.x), 1 / safe(dir.y), 1 / safe(dir.z), 1 / dir[kz]
+  int kx, ky, kz;
+  __attribute__((always_inline)) explicit RaySetup(const Ray& ray) {
+    const float ax = std::fabs(ray.dir.x), ay = std::fabs(ray.dir.y), az = std::fabs(ray.dir.z);
+    kz = ax > ay ? (ax > az ? 0 : 2) : (ay > az ? 1 : 2);
+    kx = kz == 2 ? 0 : kz + 1;
+    ky = kx == 2 ? 0 : kx + 1;
+    if (ray.dir[kz] < 0.0f) std::swap(kx, ky);  // keep the winding (watertight.h)
+    const __m128 d = _mm_setr_ps(ray.dir.x, ray.dir.y, ray.dir.z, ray.dir[kz]);
+    const __m128 tiny = _mm_set1_ps(1e-30f);
+    const __m128 first_three = _mm_castsi128_ps(_mm_setr_epi32(-1, -1, -1, 0));
+    const __m128 small = _mm_and_ps(_mm_cmplt_ps(_mm_andnot_ps(_mm_set1_ps(-0.0f), d), tiny), first_three);
+    const __m128 safe = select4(small, select4(_mm_cmplt_ps(d, _mm_setzero_ps()), _mm_set1_ps(-1e-30f), tiny), d);
+    _mm_storeu_ps(inv, _mm_div_ps(_mm_set1_ps(1.0f), safe));
+  }
+};
+
+// Per-ray constants of the slab test, broadcast to every lane; the near and far planes of
+// each axis as offsets into a node's lo/hi arrays, chosen once by the direction's signs.
+template <int W>
+struct WideRay {
+  using V = typename Lanes<W>::V;
+  V org[3], inv[3], tnear;
+  int near_plane[3], far_plane[3];
+  __attribute__((always_inline)) WideRay(const Ray& ray, const RaySetup& s) {
+    for (int d = 0; d < 3; ++d) {
+      org[d] = splat<V>(ray.org[d]);
+      inv[d] = splat<V>(s.inv[d]);
+      const bool near_hi = s.inv[d] < 0.0f;
+      near_plane[d] = (near_hi ? 3 * W : 0) + d * W;  // hi follows lo in WideNode
+      far_plane[d] = (near_hi ? 0 : 3 * W) + d * W;
+    }
+    tnear = splat<V>(ray.tnear);
+  }
+};
+
+template <int W>
+inline unsigned enter_children(const WideNode<W>& n, const WideRay<W>& r, float tmax, typename Lanes<W>::V& entry) {
+  using V = typename Lanes<W>::V;
+  const float* planes = &n.lo[0][0];
+  V t0 = r.tnear, t1 = splat<V>(tmax);
+  for (int d = 0; d < 3; ++d) {
+    t0 = vmax(t0, (load<W>(planes + r.near_plane[d]) - r.org[d]) * r.inv[d]);
+    t1 = vmin(t1, (load<W>(planes + r.far_plane[d]) - r.org[d]) * r.inv[d]);
+  }
+  entry = t0;
+  return mask_bits(t0 <= t1 * kRobustExit);
+}
+
+// Starts fetching the first two lines of what a child entered or pushed will read (an
+// interior node's boxes, a leaf's first pack), so the loads overlap with the work done
+// until it is reached, as Embree prefetches every child it pushes. (The whole node, four
+// lines, was tried: as fast on rays that miss the cache, slower on those that hit it.)
+template <int W>
+inline void prefetch_child(const WideBvh<W>& bvh, uint32_t ref, uint32_t count) {
+  const char* p =
+      count == 0 ? reinterpret_cast<const char*>(&bvh.nodes[ref]) : reinterpret_cast<const char*>(&bvh.packs[ref]);
+  _mm_prefetch(p, _MM_HINT_T0);
+  _mm_prefetch(p + 64, _MM_HINT_T0);
+}
+
+// Counting compiled in or out: the traversal calls these at every step, and the uncounted
+// variant's are empty.
+struct NoTally {
+  void node() {}
+  void pack(uint32_t) {}
+  void exact() {}
+};
+struct Tally {
+  TraversalCounters c;
+  void node() { ++c.nodes; }
+  void pack(uint32_t triangles) { ++c.packs, c.triangles += triangles; }
+  void exact() { ++c.exact_checks; }
+};
+
+// The watertight test's per-ray set-up, broadcast to the slots of a pack.
+struct PackRay {
+  const Ray& ray;  // for the exact check of accepted hits
+  RayShear shear;
+  vfp org[3];  // the origin's kx, ky, kz components
+  vfp sx, sy, sz, tnear;
+  __attribute__((always_inline)) PackRay(const Ray& r, const RaySetup& s) : ray(r), shear(r, s.kx, s.ky, s.kz, s.inv[3]) {
+    org[0] = splat<vfp>(ray.org[shear.kx]);
+    org[1] = splat<vfp>(ray.org[shear.ky]);
+    org[2] = splat<vfp>(ray.org[shear.kz]);
+    sx = splat<vfp>(shear.sx);
+    sy = splat<vfp>(shear.sy);
+    sz = splat<vfp>(shear.sz);
+    tnear = splat<vfp>(ray.tnear);
+  }
+};
+
+// The candidates of a pack's test, confirmed one by one in double precision (watertight.h:
+// exact_check): `hits`, the slots the vector test accepted, with their t; `redo`, those
+// whose edge functions came out exactly zero, for the scalar test.
+template <Query query, typename Count>
+__attribute__((always_inline)) inline int confirm_hits(const TrianglePack& p, const PackRay& r, float tnear, float tmax,
+                                                       vfp t, unsigned hits, unsigned redo, float& t_hit,
+                                                       ExactCheck& check, Count& count) {
+  auto vertex = [&](int v, int slot) { return Vec3(p.v[v][0][slot], p.v[v][1][slot], p.v[v][2][slot]); };
+  auto exact = [&](int slot) {
+    count.exact();
+    return exact_check(r.ray, vertex(0, slot), vertex(1, slot), vertex(2, slot), tnear, tmax);
+  };
+  int best = -1;
+  for (; hits; hits &= hits - 1) {
+    const int slot = __builtin_ctz(hits);
+    if (best >= 0 && !(t[slot] < t_hit)) continue;
+    const ExactCheck e = exact(slot);
+    if (!e.within) continue;
+    best = slot, t_hit = t[slot], check = e;
+    if (query == Query::Any) return best;
+  }
+  for (; redo; redo &= redo - 1) {
+    const int slot = __builtin_ctz(redo);
+    Hit h;
+    if (!intersect_watertight(r.shear, tnear, best < 0 ? tmax : t_hit, vertex(0, slot), vertex(1, slot),
+                              vertex(2, slot), h))
+      continue;
+    const ExactCheck e = exact(slot);
+    if (!e.within) continue;
+    best = slot, t_hit = h.t, check = e;
+    if (query == Query::Any) return best;
+  }
+  return best;
+}
+
+// Out of line for closest-hit queries: most packs have no candidate, and the vector test
+// keeps its registers; inline for occlusion, whose first confirmed hit ends the ray (the
+// faster of the two for each, measured).
+template <Query query, typename Count>
+__attribute__((noinline)) int confirm_hits_apart(const TrianglePack& p, const PackRay& r, float tnear, float tmax,
+                                                 vfp t, unsigned hits, unsigned redo, float& t_hit, ExactCheck& check,
+                                                 Count& count) {
+  return confirm_hits<query>(p, r, tnear, tmax, t, hits, redo, t_hit, check, count);
+}
+
+// The watertight test (cuda/traversal/watertight.h) on a pack of triangles at once, in the
+// same operations as the scalar test. Returns the slot of the nearest hit in (tnear,
+// tmax], its float t and its exact check, or -1; for Query::Any, the first slot found to
+// be hit, since any one will do. A slot whose edge functions come out exactly zero goes
+// to the scalar test, which redoes them in double precision.
+// `skip`: slots a hit filter has already turned down for this ray (0 without a filter).
+template <Query query, typename Count>
+__attribute__((always_inline)) inline int intersect_pack(const TrianglePack& p, const PackRay& r, float tnear,
+                                                         float tmax, float& t_hit, ExactCheck& check, Count& count,
+                                                         unsigned skip = 0) {
+  const RayShear& s = r.shear;
+  vfp x[3], y[3], z[3];
+  for (int v = 0; v < 3; ++v) {
+    const vfp dx = load<kPackWidth>(p.v[v][s.kx]) - r.org[0], dy = load<kPackWidth>(p.v[v][s.ky]) - r.org[1];
+    z[v] = load<kPackWidth>(p.v[v][s.kz]) - r.org[2];
+    x[v] = dx - r.sx * z[v];
+    y[v] = dy - r.sy * z[v];
+  }
+  const vfp U = x[2] * y[1] - y[2] * x[1];
+  const vfp V = x[0] * y[2] - y[0] * x[2];
+  const vfp W = x[1] * y[0] - y[1] * x[0];
+  const vfp zero{};
+  const vip negative = (U < zero) | (V < zero) | (W < zero);
+  const vip positive = (U > zero) | (V > zero) | (W > zero);
+  const vfp det = U + V + W;
+  const vfp T = U * (r.sz * z[0]) + V * (r.sz * z[1]) + W * (r.sz * z[2]);
+  const vip sign = vip(det) & (vip{} + int(0x80000000));
+  const vfp abs_det = vfp(vip(det) ^ sign), abs_T = vfp(vip(T) ^ sign);
+  const vip valid =
+      ~(negative & positive) & (det != zero) & (abs_T > r.tnear * abs_det) & (abs_T <= splat<vfp>(tmax) * abs_det);
+  const vip exact_zero = (U == zero) | (V == zero) | (W == zero);
+  const unsigned hits = mask_bits(valid & ~exact_zero) & ~skip;
+  const unsigned redo = mask_bits(exact_zero) & ~skip;
+  if (!(hits | redo)) return -1;
+  if constexpr (query == Query::Any)
+    return confirm_hits<query>(p, r, tnear, tmax, T / det, hits, redo, t_hit, check, count);
+  else
+    return confirm_hits_apart<query>(p, r, tnear, tmax, T / det, hits, redo, t_hit, check, count);
+}
+
+// Completes the hit on triangle `found` (hit.t is set): its ids, and unless `refine` is
+// false (an unfiltered occlusion query, which needs only the yes), its Ng and the t, u and
+// v of its exact check (watertight.h: apply_exact_check).
+template <int W>
+__attribute__((always_inline)) inline bool finish_hit(const WideBvh<W>& bvh, uint32_t found, const ExactCheck& check, Hit& hit, bool refine = true) {
+  if (found == kInvalidId) return false;
+  const TrianglePack& p = bvh.packs[found / kPackWidth];
+  const uint32_t slot = found % kPackWidth;
+  hit.geomID = p.id[slot].geom;
+  hit.primID = p.id[slot].prim;
+  if (!refine) return true;
+  const Vec3 a(p.v[0][0][slot], p.v[0][1][slot], p.v[0][2][slot]);
+  const Vec3 b(p.v[1][0][slot], p.v[1][1][slot], p.v[1][2][slot]);
+  const Vec3 c(p.v[2][0][slot], p.v[2][1][slot], p.v[2][2][slot]);
+  hit.Ng = cross(b - a, c - a);
+  apply_exact_check(check, a, b, c, hit);
+  return true;
+}
+
+// A ray's end: its counts, when counted, go to `counted`.
+inline bool finish(NoTally, TraversalCounters*, bool found) { return found; }
+inline bool finish(const Tally& t, TraversalCounters* counted, bool found) {
+  *counted += t.c;
+  ++counted->rays;
+  return found;
+}
+
+// The traversal, compiled once per query so the inner loop carries no test of it.
+// With a filter (Filtered), every candidate hit is offered to it before it counts, as
+// Embree offers hits to an application's filter functions; a refused one is skipped and
+// the traversal goes on.
+template <int W, Query query, bool Filtered = false, typename Count = NoTally>
+bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit, const HitFilter* filter = nullptr,
+              Count count = {}, TraversalCounters* counted = nullptr) {
+  hit = Hit();
+  if (bvh.nodes.empty() || !ray_can_hit(ray)) return finish(count, counted, false);
+  const RaySetup setup(ray);
+  const WideRay<W> wray(ray, setup);
+  const PackRay pack_ray(ray, setup);
+  float tmax = ray.tfar;
+  uint32_t found = kInvalidId;  // the closest hit's triangle so far
+  ExactCheck check;             // and its exact check
+  uint32_t sp = 0;
+  WideEntry cur{0, 0, ray.tnear};
+  for (;;) {
+    if (cur.count == 0) {
+      const WideNode<W>& n = bvh.nodes[cur.ref];
+      count.node();
+      // The children's references sit on the node's last line and are read only once the
+      // box test is done: fetch that line now, alongside the boxes.
+      _mm_prefetch(reinterpret_cast<const char*>(n.ref), _MM_HINT_T0);
+      typename Lanes<W>::V entry;
+      unsigned mask = enter_children(n, wray, tmax, entry);
+      if (mask == 0) goto pop;
+      int lane = __builtin_ctz(mask);
+      mask &= mask - 1;
+      if (mask == 0) {  // one child entered: the common case, no ordering
+        cur = WideEntry{n.ref[lane], n.count[lane], entry[lane]};
+        continue;
+      }
+      if (query == Query::Any) {  // any hit will do: no ordering
+        stack[sp++] = WideEntry{n.ref[lane], n.count[lane], entry[lane]};
+        prefetch_child(bvh, n.ref[lane], n.count[lane]);
+        for (; mask; mask &= mask - 1) {
+          lane = __builtin_ctz(mask);
+          stack[sp++] = WideEntry{n.ref[lane], n.count[lane], entry[lane]};
+          prefetch_child(bvh, n.ref[lane], n.count[lane]);
+        }
+        cur = stack[--sp];
+        continue;
+      }
+      // Several: the nearest is taken next, the others go on the stack farthest first.
+      WideEntry hits[W];
+      hits[0] = WideEntry{n.ref[lane], n.count[lane], entry[lane]};
+      prefetch_child(bvh, hits[0].ref, hits[0].count);
+      int count = 1;
+      do {
+        lane = __builtin_ctz(mask);
+        mask &= mask - 1;
+        const WideEntry e{n.ref[lane], n.count[lane], entry[lane]};
+        prefetch_child(bvh, e.ref, e.count);
+        int at = count++;
+        for (; at > 0 && hits[at - 1].entry < e.entry; --at) hits[at] = hits[at - 1];
+        hits[at] = e;
+      } while (mask);
+      for (int i = 0; i < count - 1; ++i) stack[sp++] = hits[i];
+      cur = hits[count - 1];
+      continue;
+    }
+    for (uint32_t p = cur.ref, end = cur.ref + (cur.count + kPackWidth - 1) / kPackWidth; p < end; ++p) {
+      float t;
+      count.pack(std::min<uint32_t>(kPackWidth, cur.count - (p - cur.ref) * kPackWidth));
+      if (!Filtered) {
+        ExactCheck e;
+        const int slot = intersect_pack<query>(bvh.packs[p], pack_ray, ray.tnear, tmax, t, e, count);
+        if (slot < 0) continue;
+        found = p * kPackWidth + uint32_t(slot);
+        check = e;
+        hit.t = t;
+        if (query == Query::Any) return finish(count, counted, finish_hit(bvh, found, check, hit, false));
+        tmax = t;
+        continue;
+      }
+      // The pack's nearest slot first; one the filter refuses is skipped and the next
+      // nearest tried.
+      for (unsigned skip = 0;;) {
+        ExactCheck e;
+        const int slot = intersect_pack<Query::Closest>(bvh.packs[p], pack_ray, ray.tnear, tmax, t, e, count, skip);
+        if (slot < 0) break;
+        const uint32_t candidate = p * kPackWidth + uint32_t(slot);
+        Hit offered;
+        offered.t = t;
+        finish_hit(bvh, candidate, e, offered);
+        if (!filter->accept(filter->user, ray, offered)) {
+          skip |= 1u << slot;
+          continue;
+        }
+        hit = offered;
+        if (query == Query::Any) return finish(count, counted, true);
+        found = candidate;
+        tmax = t;
+        break;  // the pack's other slots are farther
+      }
+    }
+  pop:
+    do {
+      if (sp == 0) return finish(count, counted, Filtered ? found != kInvalidId : finish_hit(bvh, found, check, hit));
+      cur = stack[--sp];
+    } while (cur.entry > tmax);
+  }
+}
+
+// This instruction set's entry points (trace_wide.cpp dispatches to them). No vector type
+// crosses them: their callers are compiled for another instruction set, whose calling
+// convention for vectors differs.
+
+// rays[0, n) one after another, into hits; counted into `counters` when it is not null.
+template <int W>
+void trace_rays(const WideBvh<W>& bvh, const Ray* rays, size_t n, Query query, Hit* hits, WideEntry* stack,
+                TraversalCounters* counters) {
+  for (size_t i = 0; i < n; ++i) {
+    if (!counters) {
+      if (query == Query::Any) {
+        traverse<W, Query::Any>(bvh, rays[i], stack, hits[i]);
+      } else {
+        traverse<W, Query::Closest>(bvh, rays[i], stack, hits[i]);
+      }
+    } else if (query == Query::Any) {
+      traverse<W, Query::Any, false, Tally>(bvh, rays[i], stack, hits[i], nullptr, Tally{}, counters);
+    } else {
+      traverse<W, Query::Closest, false, Tally>(bvh, rays[i], stack, hits[i], nullptr, Tally{}, counters);
+    }
+  }
+}
+
+// One ray, with every candidate hit offered to `filter` when it is not null.
+template <int W>
+bool trace_one(const WideBvh<W>& bvh, const Ray& ray, Query query, WideEntry* stack, Hit& hit,
+               const HitFilter* filter) {
+  if (filter) {
+    return query == Query::Any ? traverse<W, Query::Any, true>(bvh, ray, stack, hit, filter)
+                               : traverse<W, Query::Closest, true>(bvh, ray, stack, hit, filter);
+  }
+  return query == Query::Any ? traverse<W, Query::Any>(bvh, ray, stack, hit)
+                             : traverse<W, Query::Closest>(bvh, ray, stack, hit);
+}
