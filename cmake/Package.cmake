@@ -23,7 +23,10 @@ target_link_libraries(kmbvh_library PRIVATE fmt::fmt OpenMP::OpenMP_CXX)
 if(KMBVH_HAS_CUDA)
   target_link_libraries(kmbvh_library PRIVATE CUDA::cudart_static)
 endif()
-target_link_options(kmbvh_library PRIVATE -Wl,--no-undefined)
+if(NOT KMBVH_SANITIZERS AND NOT KMBVH_FUZZ)
+  # Instrumented builds leave the sanitizer runtime to the executable (as plugin/ does).
+  target_link_options(kmbvh_library PRIVATE -Wl,--no-undefined)
+endif()
 target_include_directories(kmbvh_library PUBLIC
   "$<BUILD_INTERFACE:${PROJECT_SOURCE_DIR};${PROJECT_BINARY_DIR}/include>"
   "$<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR};${CMAKE_INSTALL_INCLUDEDIR}/kmbvh>")

@@ -360,11 +360,12 @@ bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit,
         tmax = t;
         continue;
       }
-      // The pack's nearest slot first; one the filter refuses is skipped and the next
-      // nearest tried.
+      // For the closest hit, the pack's nearest slot first; for occlusion, the first slot
+      // found to be hit (Embree offers occlusion candidates in no particular order). One
+      // the filter refuses is skipped and the next tried.
       for (unsigned skip = 0;;) {
         ExactCheck e;
-        const int slot = intersect_pack<Query::Closest>(bvh.packs[p], pack_ray, ray.tnear, tmax, t, e, count, skip);
+        const int slot = intersect_pack<query>(bvh.packs[p], pack_ray, ray.tnear, tmax, t, e, count, skip);
         if (slot < 0) break;
         const uint32_t candidate = p * kPackWidth + uint32_t(slot);
         Hit offered;
