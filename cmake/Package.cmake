@@ -39,10 +39,9 @@ target_compile_features(kmbvh_library INTERFACE cxx_std_17)
 kmbvh_warnings(kmbvh_library)
 add_library(kmbvh::kmbvh ALIAS kmbvh_library)
 
-set_target_properties(kmbvh_embree PROPERTIES VERSION ${PROJECT_VERSION}
+set_target_properties(kmbvh_embree PROPERTIES EXPORT_NAME embree VERSION ${PROJECT_VERSION}
                                               SOVERSION ${PROJECT_VERSION_MAJOR}.${PROJECT_VERSION_MINOR})
 target_include_directories(kmbvh_embree PUBLIC "$<INSTALL_INTERFACE:${CMAKE_INSTALL_INCLUDEDIR}>")
-set_target_properties(kmbvh_embree PROPERTIES EXPORT_NAME embree)
 
 install(TARGETS kmbvh_library kmbvh_embree EXPORT kmbvhTargets
         LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR} ARCHIVE DESTINATION ${CMAKE_INSTALL_LIBDIR}

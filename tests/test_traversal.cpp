@@ -50,19 +50,6 @@ std::vector<Hit> brute_force(const TriangleScene& scene, const std::vector<Ray>&
   return hits;
 }
 
-std::vector<Ray> test_rays(const TriangleScene& scene, uint32_t n, uint32_t seed) {
-  std::vector<Ray> rays;
-  for (uint32_t i = 0; i < n; ++i) {
-    const test::Ray r = i % 2 ? test::random_ray(scene.bounds(), seed, i) : test::ray_towards_triangle(scene, seed + 1, i);
-    Ray ray;
-    ray.org = r.origin;
-    ray.dir = r.direction;
-    ray.tfar = i % 7 == 3 ? 0.5f : kInf;  // some bounded intervals too
-    rays.push_back(ray);
-  }
-  return rays;
-}
-
 std::vector<Layout> layouts_for(const Bvh& bvh) {
   const uint32_t arity = tree_arity(bvh);
   std::vector<Layout> out;
@@ -100,17 +87,17 @@ void expect_layouts_match_brute_force(const TriangleScene& scene, const std::vec
 
 TEST(Traversal, RandomSceneEveryBuilderEveryLayout) {
   const TriangleScene scene = test::random_triangles(3000, 31);
-  expect_layouts_match_brute_force(scene, test_rays(scene, 2000, 5), "random");
+  expect_layouts_match_brute_force(scene, test::traversal_rays(scene, 2000, 5), "random");
 }
 
 TEST(Traversal, ClusteredSceneEveryBuilderEveryLayout) {
   const TriangleScene scene = test::clustered_triangles(3000, 32);
-  expect_layouts_match_brute_force(scene, test_rays(scene, 2000, 6), "clustered");
+  expect_layouts_match_brute_force(scene, test::traversal_rays(scene, 2000, 6), "clustered");
 }
 
 TEST(Traversal, IdenticalTrianglesEveryBuilderEveryLayout) {
   const TriangleScene scene = test::identical_triangles(500);
-  expect_layouts_match_brute_force(scene, test_rays(scene, 500, 7), "identical");
+  expect_layouts_match_brute_force(scene, test::traversal_rays(scene, 500, 7), "identical");
 }
 
 // A tree whose depth is the number of triangles: node i has leaf i and node i + 1 below it.
@@ -137,7 +124,7 @@ TEST(Traversal, ChainDeeperThanAnyFixedStack) {
   const PrimitiveSet prims = make_primitive_set(scene);
   const Bvh chain = chain_tree(prims);
   ASSERT_TRUE(validate(chain, prims, ValidationLimits{1, 2}).ok());
-  const std::vector<Ray> rays = test_rays(scene, 400, 8);
+  const std::vector<Ray> rays = test::traversal_rays(scene, 400, 8);
   const std::vector<Hit> expected = brute_force(scene, rays, Query::Closest);
   for (const Layout layout : {Layout::Bvh2, Layout::Bvh4, Layout::Bvh8}) {
     const Tracer tracer(chain, prims, scene, layout);
@@ -152,7 +139,7 @@ TEST(Traversal, ZeroAreaTrianglesAreNeverHit) {
   const TriangleScene scene = test::zero_area_triangles(2000, 23);
   const PrimitiveSet prims = make_primitive_set(scene);
   const Bvh bvh = run_builder(parse_builder("Q2"), prims);
-  const std::vector<Ray> rays = test_rays(scene, 2000, 9);
+  const std::vector<Ray> rays = test::traversal_rays(scene, 2000, 9);
   for (const Layout layout : {Layout::Bvh2, Layout::Bvh4, Layout::Bvh8}) {
     std::vector<Hit> hits;
     Tracer(bvh, prims, scene, layout).trace(rays, Query::Closest, hits);

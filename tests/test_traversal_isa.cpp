@@ -4,7 +4,6 @@
 #include <gtest/gtest.h>
 
 #include <cstring>
-#include <limits>
 #include <string>
 
 #include "adapters/builder_registry.h"
@@ -17,19 +16,6 @@
 
 namespace kmbvh {
 namespace {
-
-std::vector<Ray> isa_test_rays(const TriangleScene& scene, uint32_t n) {
-  std::vector<Ray> rays;
-  for (uint32_t i = 0; i < n; ++i) {
-    const test::Ray r = i % 2 ? test::random_ray(scene.bounds(), 7, i) : test::ray_towards_triangle(scene, 8, i);
-    Ray ray;
-    ray.org = r.origin;
-    ray.dir = r.direction;
-    ray.tfar = i % 5 == 2 ? 0.5f : std::numeric_limits<float>::infinity();
-    rays.push_back(ray);
-  }
-  return rays;
-}
 
 bool same_counts(const TraversalCounters& a, const TraversalCounters& b) {
   return a.rays == b.rays && a.nodes == b.nodes && a.packs == b.packs && a.triangles == b.triangles &&
@@ -72,7 +58,7 @@ TEST(TraversalIsa, EveryInstructionSetThisCpuRunsGivesTheSameHitsBitForBit) {
   ASSERT_TRUE(cpu_runs(CpuIsa::Sse42));
   const TriangleScene scene = test::random_triangles(3000, 91);
   const PrimitiveSet prims = make_primitive_set(scene);
-  const std::vector<Ray> rays = isa_test_rays(scene, 4000);
+  const std::vector<Ray> rays = test::traversal_rays(scene, 4000, 7);
   for (const char* spec : {"sweep-sah", "Q2"}) {
     const Bvh bvh = run_builder(test::config_from_spec(spec), prims);
     expect_every_isa_agrees<4>(bvh, prims, scene, rays, spec);

@@ -26,6 +26,16 @@ TraversalCounters& TraversalCounters::operator+=(const TraversalCounters& o) {
 // x86-64-v2 (adapters/CMakeLists.txt), and so is the SSE4.2 variant; the AVX2 and AVX-512
 // variants are compiled in target regions that add their features (the same lists as
 // cpu_isa.cpp checks), so one binary runs on every x86-64 CPU and uses what it has.
+#define KMBVH_PRAGMA(text) _Pragma(#text)
+#if defined(__clang__)
+#define KMBVH_TARGET_BEGIN(features) \
+  KMBVH_PRAGMA(clang attribute push(__attribute__((target(features))), apply_to = function))
+#define KMBVH_TARGET_END KMBVH_PRAGMA(clang attribute pop)
+#else
+#define KMBVH_TARGET_BEGIN(features) KMBVH_PRAGMA(GCC push_options) KMBVH_PRAGMA(GCC target(features))
+#define KMBVH_TARGET_END KMBVH_PRAGMA(GCC pop_options)
+#endif
+
 namespace wide_sse42 {
 constexpr bool kAvx = false;
 namespace {
@@ -33,41 +43,23 @@ namespace {
 }  // namespace
 }  // namespace wide_sse42
 
-#if defined(__clang__)
-#pragma clang attribute push(__attribute__((target("popcnt,avx,avx2,fma,bmi,bmi2"))), apply_to = function)
-#else
-#pragma GCC push_options
-#pragma GCC target("popcnt,avx,avx2,fma,bmi,bmi2")
-#endif
+KMBVH_TARGET_BEGIN("popcnt,avx,avx2,fma,bmi,bmi2")
 namespace wide_avx2 {
 constexpr bool kAvx = true;
 namespace {
 #include "trace_wide_kernel.inl"
 }  // namespace
 }  // namespace wide_avx2
-#if defined(__clang__)
-#pragma clang attribute pop
-#else
-#pragma GCC pop_options
-#endif
+KMBVH_TARGET_END
 
-#if defined(__clang__)
-#pragma clang attribute push(__attribute__((target("popcnt,avx,avx2,fma,bmi,bmi2,avx512f,avx512vl,avx512bw,avx512dq,avx512cd"))), apply_to = function)
-#else
-#pragma GCC push_options
-#pragma GCC target("popcnt,avx,avx2,fma,bmi,bmi2,avx512f,avx512vl,avx512bw,avx512dq,avx512cd")
-#endif
+KMBVH_TARGET_BEGIN("popcnt,avx,avx2,fma,bmi,bmi2,avx512f,avx512vl,avx512bw,avx512dq,avx512cd")
 namespace wide_avx512 {
 constexpr bool kAvx = true;
 namespace {
 #include "trace_wide_kernel.inl"
 }  // namespace
 }  // namespace wide_avx512
-#if defined(__clang__)
-#pragma clang attribute pop
-#else
-#pragma GCC pop_options
-#endif
+KMBVH_TARGET_END
 
 namespace {
 

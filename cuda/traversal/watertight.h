@@ -142,10 +142,6 @@ KMBVH_HD KMBVH_INLINE ExactCheck exact_check(const Ray& ray, Vec3 a, Vec3 b, Vec
   return check;
 }
 
-KMBVH_HD KMBVH_INLINE bool exact_t_within(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, float tnear, float tmax) {
-  return exact_check(ray, a, b, c, tnear, tmax).within;
-}
-
 // The watertight test decides hit or miss, but its sheared, origin-relative coordinates
 // lose digits of t, u and v when the triangle is thin and seen almost edge-on from far
 // away (a wall across a room: u off by 1e-3 in float, by any float method; Embree's too).

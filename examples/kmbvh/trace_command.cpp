@@ -41,26 +41,22 @@ std::vector<RayKind> parse_kinds(const std::string& list) {
   return out;
 }
 
-// Median wall time of `runs` calls after `warmup` untimed ones, in seconds.
-template <typename F>
-double median_seconds(int runs, int warmup, const F& f) {
-  for (int i = 0; i < warmup; ++i) f();
-  std::vector<double> ms;
-  for (int i = 0; i < runs; ++i) {
-    const auto start = std::chrono::steady_clock::now();
-    f();
-    ms.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
-  }
-  return median(ms);
-}
-
-double mrays(size_t rays, double seconds) { return seconds > 0 ? double(rays) / seconds * 1e-6 : 0.0; }
-
+// Wall time of one call, in seconds.
 double seconds_of(const std::function<void()>& f) {
   const auto start = std::chrono::steady_clock::now();
   f();
   return std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count();
 }
+
+// Median wall time of `runs` calls after `warmup` untimed ones, in seconds.
+double median_seconds(int runs, int warmup, const std::function<void()>& f) {
+  for (int i = 0; i < warmup; ++i) f();
+  std::vector<double> seconds;
+  for (int i = 0; i < runs; ++i) seconds.push_back(seconds_of(f));
+  return median(seconds);
+}
+
+double mrays(size_t rays, double seconds) { return seconds > 0 ? double(rays) / seconds * 1e-6 : 0.0; }
 
 // `ours` and `theirs` timed in turn, `runs` times after `warmup` untimed pairs: the load of
 // a shared machine moves both alike within a pair, so the median of the pairs' ratios

@@ -113,4 +113,17 @@ Ray ray_towards_triangle(const TriangleScene& scene, uint32_t seed, uint32_t ind
   return r;
 }
 
+std::vector<kmbvh::Ray> traversal_rays(const TriangleScene& scene, uint32_t n, uint32_t seed) {
+  std::vector<kmbvh::Ray> rays;
+  for (uint32_t i = 0; i < n; ++i) {
+    const Ray r = i % 2 ? random_ray(scene.bounds(), seed, i) : ray_towards_triangle(scene, seed + 1, i);
+    kmbvh::Ray ray;
+    ray.org = r.origin;
+    ray.dir = r.direction;
+    ray.tfar = i % 7 == 3 ? 0.5f : std::numeric_limits<float>::infinity();  // some bounded intervals too
+    rays.push_back(ray);
+  }
+  return rays;
+}
+
 }  // namespace kmbvh::test

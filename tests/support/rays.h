@@ -5,9 +5,11 @@
 
 #include <cstdint>
 #include <limits>
+#include <vector>
 
 #include "adapters/in/triangle_scene.h"
 #include "cuda/core/bvh.h"
+#include "cuda/traversal/ray.h"
 
 namespace kmbvh::test {
 
@@ -35,5 +37,9 @@ Ray random_ray(const Aabb& bounds, uint32_t seed, uint32_t index);
 // Rays from random points around the scene towards a random triangle (most of them hit
 // something, even in a sparse scene).
 Ray ray_towards_triangle(const TriangleScene& scene, uint32_t seed, uint32_t index);
+
+// n rays for the traversals, in their conventions: odd ones by random_ray (seed), even ones
+// by ray_towards_triangle (seed + 1); every seventh bounded (tfar 0.5), the rest unbounded.
+std::vector<kmbvh::Ray> traversal_rays(const TriangleScene& scene, uint32_t n, uint32_t seed);
 
 }  // namespace kmbvh::test
