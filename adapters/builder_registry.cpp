@@ -12,33 +12,66 @@
 namespace kmbvh {
 namespace {
 
-bool is_binary(const std::string& name) {
-  return name == "lbvh" || name == "hlbvh" || name == "atrbvh" || name == "ploc";
-}
+struct KindName {
+  BuilderKind kind;
+  const char* name;
+};
+constexpr KindName kKindNames[] = {
+    {BuilderKind::SweepSah, "sweep-sah"},   {BuilderKind::Lbvh, "lbvh"},
+    {BuilderKind::Hlbvh, "hlbvh"},          {BuilderKind::Atrbvh, "atrbvh"},
+    {BuilderKind::Ploc, "ploc"},            {BuilderKind::Kmeans, "kmeans"},
+    {BuilderKind::EmbreeLow, "embree-low"}, {BuilderKind::EmbreeMedium, "embree-medium"},
+    {BuilderKind::EmbreeHigh, "embree-high"},
+};
 
-bool is_embree(const std::string& name, EmbreeQuality* quality) {
-  if (name == "embree-low") *quality = EmbreeQuality::Low;
-  else if (name == "embree-medium") *quality = EmbreeQuality::Medium;
-  else if (name == "embree-high") *quality = EmbreeQuality::High;
-  else return false;
-  return true;
+EmbreeQuality embree_quality(BuilderKind kind) {
+  switch (kind) {
+    case BuilderKind::EmbreeLow: return EmbreeQuality::Low;
+    case BuilderKind::EmbreeHigh: return EmbreeQuality::High;
+    default: return EmbreeQuality::Medium;
+  }
 }
 
 }  // namespace
 
-bool is_embree_builder(const std::string& name) {
-  EmbreeQuality quality;
-  return is_embree(name, &quality);
+const char* to_string(BuilderKind kind) {
+  for (const KindName& k : kKindNames)
+    if (k.kind == kind) return k.name;
+  return "unknown";
+}
+
+std::optional<BuilderKind> builder_kind(const std::string& name) {
+  for (const KindName& k : kKindNames)
+    if (name == k.name) return k.kind;
+  return std::nullopt;
+}
+
+const std::vector<BuilderKind>& builder_kinds() {
+  static const std::vector<BuilderKind> kinds = [] {
+    std::vector<BuilderKind> all;
+    for (const KindName& k : kKindNames) all.push_back(k.kind);
+    return all;
+  }();
+  return kinds;
+}
+
+bool is_embree_builder(BuilderKind kind) {
+  return kind == BuilderKind::EmbreeLow || kind == BuilderKind::EmbreeMedium || kind == BuilderKind::EmbreeHigh;
+}
+
+bool is_binary_builder(BuilderKind kind) {
+  return kind == BuilderKind::Lbvh || kind == BuilderKind::Hlbvh || kind == BuilderKind::Atrbvh ||
+         kind == BuilderKind::Ploc;
 }
 
 std::string BuilderConfig::label() const {
   const BinaryBuildParams defaults;
-  if (builder == "ploc" && binary.ploc_radius != defaults.ploc_radius)
+  if (builder == BuilderKind::Ploc && binary.ploc_radius != defaults.ploc_radius)
     return fmt::format("ploc r={}", binary.ploc_radius);
-  if (builder == "atrbvh" &&
+  if (builder == BuilderKind::Atrbvh &&
       (binary.treelet_size != defaults.treelet_size || binary.treelet_iterations != defaults.treelet_iterations))
     return fmt::format("atrbvh t={} i={}", binary.treelet_size, binary.treelet_iterations);
-  if (builder != "kmeans") return builder;
+  if (builder != BuilderKind::Kmeans) return to_string(builder);
   const std::string medians = kmeans.metric == ClusterMetric::Medians ? " medians" : "";
   const std::string wide = kmeans.wide ? " wide" : "";
   if (!preset.empty()) return fmt::format("kmeans {}{}{}", preset, medians, wide);
@@ -47,12 +80,6 @@ std::string BuilderConfig::label() const {
                              : kmeans.settle_fraction > 0 ? fmt::format(" until-stable({:g})", kmeans.settle_fraction)
                                                           : " until-stable";
   return fmt::format("kmeans k={} p={} i={}{}{}{}{}", kmeans.k, kmeans.p, kmeans.i, adaptive, stable, medians, wide);
-}
-
-const std::vector<std::string>& builder_names() {
-  static const std::vector<std::string> names{"sweep-sah", "lbvh",       "hlbvh",         "atrbvh",     "ploc",
-                                              "kmeans",    "embree-low", "embree-medium", "embree-high"};
-  return names;
 }
 
 BuilderConfig parse_builder(const std::string& spec) {
@@ -65,17 +92,19 @@ BuilderConfig parse_builder(const std::string& spec) {
     name = "kmeans";
     preset = spec;
   }
-  config.builder = name;
-  EmbreeQuality quality;
-  if (name == "kmeans") {
+  const std::optional<BuilderKind> kind = builder_kind(name);
+  if (!kind)
+    throw std::invalid_argument(fmt::format(
+        "unknown builder '{}' (sweep-sah, lbvh, hlbvh, atrbvh, ploc, kmeans, Q1..Q5, QA, embree-low|medium|high)", spec));
+  config.builder = *kind;
+  if (*kind == BuilderKind::Kmeans) {
     const auto params = kmeans_preset(preset);
     if (!params) throw std::invalid_argument(fmt::format("unknown k-means preset '{}' (Q1 to Q5, QA)", preset));
     config.kmeans = *params;
     config.preset = preset;
     for (char& c : config.preset) c = char(std::toupper(static_cast<unsigned char>(c)));
-  } else if (!is_embree(name, &quality) && !is_binary(name) && name != "sweep-sah") {
-    throw std::invalid_argument(fmt::format(
-        "unknown builder '{}' (sweep-sah, lbvh, hlbvh, atrbvh, ploc, kmeans, Q1..Q5, QA, embree-low|medium|high)", spec));
+  } else if (spec.find(':') != std::string::npos) {
+    throw std::invalid_argument(fmt::format("'{}': only kmeans takes a preset (kmeans:Q3)", spec));
   }
   return config;
 }
@@ -89,17 +118,16 @@ std::vector<BuilderConfig> all_builders() {
 }
 
 void check_config(const BuilderConfig& config) {
-  EmbreeQuality quality;
   std::string problem;
-  if (config.builder == "kmeans") {
+  if (config.builder == BuilderKind::Kmeans) {
     KMeansParams params = config.kmeans;
     params.max_leaf_size = config.max_leaf_size;
     problem = check_params(params);
-  } else if (is_binary(config.builder)) {
+  } else if (is_binary_builder(config.builder)) {
     BinaryBuildParams params = config.binary;
     params.max_leaf_size = config.max_leaf_size;
     problem = check_params(params);
-  } else if (is_embree(config.builder, &quality)) {
+  } else if (is_embree_builder(config.builder)) {
     if (config.max_leaf_size < 1 || config.max_leaf_size > RTC_BUILD_MAX_PRIMITIVES_PER_LEAF)
       problem = fmt::format("Embree's leaves hold 1 to {} primitives, got {}", int(RTC_BUILD_MAX_PRIMITIVES_PER_LEAF),
                             config.max_leaf_size);
@@ -110,44 +138,44 @@ void check_config(const BuilderConfig& config) {
 }
 
 void prepare_builder(const BuilderConfig& config) {
-  EmbreeQuality quality;
-  if (is_embree(config.builder, &quality)) shared_embree_device();
+  if (is_embree_builder(config.builder)) shared_embree_device();
 }
 
 Bvh run_builder(const BuilderConfig& config, const PrimitiveSet& prims, BuildInfo* info) {
   check_config(config);
-  EmbreeQuality quality;
-  if (config.builder == "kmeans") {
-    KMeansParams params = config.kmeans;
-    params.max_leaf_size = config.max_leaf_size;
-    return build_kmeans(prims, params, config.backend, info);
+  BinaryBuildParams binary = config.binary;
+  binary.max_leaf_size = config.max_leaf_size;
+  switch (config.builder) {
+    case BuilderKind::Kmeans: {
+      KMeansParams params = config.kmeans;
+      params.max_leaf_size = config.max_leaf_size;
+      return build_kmeans(prims, params, config.backend, info);
+    }
+    case BuilderKind::Lbvh: return build_lbvh(prims, binary, config.backend, info);
+    case BuilderKind::Hlbvh: return build_hlbvh(prims, binary, config.backend, info);
+    case BuilderKind::Atrbvh: return build_atrbvh(prims, binary, config.backend, info);
+    case BuilderKind::Ploc: return build_ploc(prims, binary, config.backend, info);
+    case BuilderKind::SweepSah: {
+      SweepSahParams params;
+      params.max_leaf_size = config.max_leaf_size;
+      return build_sweep_sah(prims, params, info);
+    }
+    case BuilderKind::EmbreeLow:
+    case BuilderKind::EmbreeMedium:
+    case BuilderKind::EmbreeHigh: {
+      EmbreeBuildOptions options;
+      options.quality = embree_quality(config.builder);
+      options.max_leaf_size = config.max_leaf_size;
+      return build_embree(prims, options, info);
+    }
   }
-  if (is_binary(config.builder)) {
-    BinaryBuildParams params = config.binary;
-    params.max_leaf_size = config.max_leaf_size;
-    if (config.builder == "lbvh") return build_lbvh(prims, params, config.backend, info);
-    if (config.builder == "hlbvh") return build_hlbvh(prims, params, config.backend, info);
-    if (config.builder == "atrbvh") return build_atrbvh(prims, params, config.backend, info);
-    return build_ploc(prims, params, config.backend, info);
-  }
-  if (config.builder == "sweep-sah") {
-    SweepSahParams params;
-    params.max_leaf_size = config.max_leaf_size;
-    return build_sweep_sah(prims, params, info);
-  }
-  if (is_embree(config.builder, &quality)) {
-    EmbreeBuildOptions options;
-    options.quality = quality;
-    options.max_leaf_size = config.max_leaf_size;
-    return build_embree(prims, options, info);
-  }
-  throw std::invalid_argument(fmt::format("unknown builder '{}'", config.builder));
+  throw std::invalid_argument(fmt::format("unknown builder kind {}", int(config.builder)));
 }
 
 ValidationLimits validation_limits(const BuilderConfig& config) {
   ValidationLimits limits;
   limits.max_leaf_size = config.max_leaf_size;
-  limits.max_arity = (config.builder == "kmeans" && config.kmeans.wide) ? config.kmeans.k : 2;
+  limits.max_arity = (config.builder == BuilderKind::Kmeans && config.kmeans.wide) ? config.kmeans.k : 2;
   return limits;
 }
 

@@ -3,6 +3,7 @@
 // the same code.
 #pragma once
 
+#include <optional>
 #include <string>
 #include <vector>
 
@@ -15,11 +16,28 @@
 
 namespace kmbvh {
 
+// Every builder the registry runs: kmbvh's own, then Embree's. Names are parsed into this
+// once, where they come in (parse_builder: the command line, the plug-in's environment), and
+// everything past that point switches on the kind.
+enum class BuilderKind { SweepSah, Lbvh, Hlbvh, Atrbvh, Ploc, Kmeans, EmbreeLow, EmbreeMedium, EmbreeHigh };
+
+// "sweep-sah", "lbvh", "hlbvh", "atrbvh", "ploc", "kmeans", "embree-low", "embree-medium", "embree-high".
+const char* to_string(BuilderKind kind);
+// The kind of a builder's name (as to_string writes it), or none.
+std::optional<BuilderKind> builder_kind(const std::string& name);
+// Every kind, in the order above.
+const std::vector<BuilderKind>& builder_kinds();
+
+// embree-low, embree-medium, embree-high: Embree's own builders, not kmbvh's.
+bool is_embree_builder(BuilderKind kind);
+// lbvh, hlbvh, atrbvh, ploc: the binary builders of the portable loop (BinaryBuildParams).
+bool is_binary_builder(BuilderKind kind);
+
 struct BuilderConfig {
-  std::string builder = "kmeans";  // one of builder_names()
+  BuilderKind builder = BuilderKind::Kmeans;
   KMeansParams kmeans;             // for "kmeans"
   std::string preset;              // the preset kmeans was set from ("Q2"), or empty
-  BinaryBuildParams binary;        // for "lbvh", "hlbvh", "atrbvh", "ploc" (their own parameters)
+  BinaryBuildParams binary;        // for the binary builders (their own parameters)
   Backend backend = Backend::Cpu;  // for the portable builders (kmeans and the binary ones)
   uint32_t max_leaf_size = 8;      // for every builder
 
@@ -27,12 +45,7 @@ struct BuilderConfig {
   std::string label() const;
 };
 
-const std::vector<std::string>& builder_names();
-
-// embree-low, embree-medium, embree-high: Embree's own builders, not kmbvh's.
-bool is_embree_builder(const std::string& name);
-
-// "kmeans" with the preset, "kmeans:Q3", "Q3" (shorthand), or any other builder name.
+// "kmeans" (preset Q2), "kmeans:Q3", "Q3" (shorthand), or any other builder's name.
 // Throws std::invalid_argument naming what is unknown.
 BuilderConfig parse_builder(const std::string& spec);
 

@@ -10,7 +10,7 @@
 //   tracer.trace(rays, Query::Closest, hits);                   // Embree's hit conventions
 #pragma once
 
-#include "adapters/in/triangle_scene.h"
+#include "adapters/triangles/triangle_scene.h"
 #include "adapters/out/tracer.h"
 #include "cuda/binary/binary_builders.h"
 #include "cuda/core/bvh.h"

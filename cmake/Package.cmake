@@ -53,9 +53,8 @@ endif()
 
 set(_kmbvh_headers ${CMAKE_INSTALL_INCLUDEDIR}/kmbvh)
 install(DIRECTORY cuda/ DESTINATION ${_kmbvh_headers}/cuda FILES_MATCHING PATTERN "*.h" PATTERN "*.inl")
-install(DIRECTORY adapters/out/ DESTINATION ${_kmbvh_headers}/adapters/out FILES_MATCHING PATTERN "*.h"
-        PATTERN "embree_callbacks.h" EXCLUDE PATTERN "image_file.h" EXCLUDE)
-install(FILES adapters/in/triangle_scene.h DESTINATION ${_kmbvh_headers}/adapters/in)
+install(DIRECTORY adapters/out/ DESTINATION ${_kmbvh_headers}/adapters/out FILES_MATCHING PATTERN "*.h")
+install(FILES adapters/triangles/triangle_scene.h DESTINATION ${_kmbvh_headers}/adapters/triangles)
 install(FILES adapters/kmbvh.h ${PROJECT_BINARY_DIR}/include/kmbvh/version.h plugin/include/kmbvh/embree.h
               plugin/include/kmbvh/embree_swap.h DESTINATION ${_kmbvh_headers})
 

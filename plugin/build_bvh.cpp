@@ -8,8 +8,8 @@
 #include <cstddef>
 #include <cstring>
 
-#include "adapters/embree/build_primitives.h"
-#include "adapters/out/embree_callbacks.h"
+#include "adapters/builder_api/build_primitives.h"
+#include "adapters/builder_api/embree_callbacks.h"
 #include "bvh_object.h"
 #include "device_errors.h"
 #include "plugin_config.h"

@@ -38,7 +38,7 @@ PluginConfig read_plugin_config() {
       throw std::invalid_argument("KMBVH_BUILDER=" + builder + ": Embree's builders are reached with KMBVH_BUILDER=embree");
     const BuilderConfig parsed = parse_builder(builder);  // throws for an unknown name
     c.builder = parsed.builder;
-    if (parsed.builder == "kmeans" && builder != "kmeans") c.preset = parsed.preset;  // "Q4", "kmeans:Q4"
+    if (parsed.builder == BuilderKind::Kmeans && builder != "kmeans") c.preset = parsed.preset;  // "Q4", "kmeans:Q4"
   }
   if (!env("KMBVH_PRESET").empty()) {
     if (!kmeans_preset(env("KMBVH_PRESET")))
@@ -73,8 +73,9 @@ const PluginConfig& plugin_config() {
 }
 
 BuilderConfig builder_for(const PluginConfig& config, RTCBuildQuality quality) {
-  if (config.builder != "kmeans") {
-    BuilderConfig b = parse_builder(config.builder);
+  if (config.builder != BuilderKind::Kmeans) {
+    BuilderConfig b;
+    b.builder = config.builder;
     b.backend = config.backend;
     return b;
   }

@@ -17,7 +17,7 @@ namespace kmbvh::plugin {
 
 struct PluginConfig {
   bool pass_through = false;  // KMBVH_BUILDER=embree
-  std::string builder = "kmeans";
+  BuilderKind builder = BuilderKind::Kmeans;
   std::string preset;         // empty: by build quality
   uint32_t k = 0, p = 0, i = 0;  // 0: the preset's
   Backend backend = Backend::Cpu;

@@ -13,7 +13,7 @@
 #include "adapters/in/default_scene.h"
 #include "adapters/in/load_scene.h"
 #include "adapters/in/scene_folder.h"
-#include "adapters/out/image_file.h"
+#include "adapters/render/image_file.h"
 #include "adapters/out/tracer.h"
 #include "adapters/render/render_scene.h"
 #include "adapters/render/traversals.h"

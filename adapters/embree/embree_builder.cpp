@@ -8,7 +8,7 @@
 #include <new>
 #include <stdexcept>
 
-#include "build_primitives.h"
+#include "adapters/builder_api/build_primitives.h"
 #include "embree_device.h"
 
 namespace kmbvh {

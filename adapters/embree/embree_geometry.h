@@ -11,7 +11,7 @@
 #include <stdexcept>
 #include <vector>
 
-#include "adapters/in/triangle_scene.h"
+#include "adapters/triangles/triangle_scene.h"
 #include "cuda/core/primitive_set.h"
 
 namespace kmbvh {

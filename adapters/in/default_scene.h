@@ -4,7 +4,7 @@
 // between them, thin poles and cables (needle triangles), and one far outlier.
 #pragma once
 
-#include "triangle_scene.h"
+#include "adapters/triangles/triangle_scene.h"
 
 namespace kmbvh {
 

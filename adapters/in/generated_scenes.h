@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "triangle_scene.h"
+#include "adapters/triangles/triangle_scene.h"
 
 namespace kmbvh {
 

@@ -7,7 +7,7 @@
 #include <optional>
 #include <string>
 
-#include "triangle_scene.h"
+#include "adapters/triangles/triangle_scene.h"
 
 namespace kmbvh {
 

@@ -3,7 +3,7 @@
 
 #include <string>
 
-#include "triangle_scene.h"
+#include "adapters/triangles/triangle_scene.h"
 
 namespace kmbvh {
 

@@ -5,7 +5,7 @@
 
 #include <vector>
 
-#include "adapters/in/triangle_scene.h"
+#include "adapters/triangles/triangle_scene.h"
 #include "cuda/core/bvh.h"
 #include "cuda/traversal/bvh2.h"
 

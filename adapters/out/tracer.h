@@ -9,7 +9,7 @@
 #include <string>
 #include <vector>
 
-#include "adapters/in/triangle_scene.h"
+#include "adapters/triangles/triangle_scene.h"
 #include "adapters/out/trace_wide.h"
 #include "cuda/core/backend.h"
 #include "cuda/core/bvh.h"

@@ -13,7 +13,7 @@
 #include <unordered_map>
 #include <vector>
 
-#include "adapters/in/triangle_scene.h"
+#include "adapters/triangles/triangle_scene.h"
 #include "cuda/traversal/ray.h"
 
 namespace kmbvh {

@@ -8,7 +8,7 @@
 #include <string>
 #include <vector>
 
-#include "adapters/in/triangle_scene.h"
+#include "adapters/triangles/triangle_scene.h"
 #include "cuda/traversal/ray.h"
 
 namespace kmbvh {

@@ -3,7 +3,7 @@
 // builder under test and every builder and layout is traced on the very same rays.
 #pragma once
 
-#include "adapters/in/triangle_scene.h"
+#include "adapters/triangles/triangle_scene.h"
 #include "ray_sets.h"
 
 namespace kmbvh {

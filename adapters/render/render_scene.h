@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "adapters/in/triangle_scene.h"
+#include "adapters/triangles/triangle_scene.h"
 #include "cuda/render/camera.h"
 #include "cuda/render/path_tracer.h"
 #include "scene_survey.h"

@@ -11,7 +11,7 @@
 
 #include <vector>
 
-#include "adapters/in/triangle_scene.h"
+#include "adapters/triangles/triangle_scene.h"
 #include "cuda/render/camera.h"
 #include "cuda/render/lighting.h"
 

@@ -1,18 +1,15 @@
 // kmbvh bench [SCENES...]: every chosen builder on every scene in one process, so build
 // times can be compared as ratios measured in the same run (docs/design.md §6). Two suites
-// besides: --suite paper (time to image with the path tracer, paper_suite.cpp) and
+// besides: --suite paper (time to image with the path tracer, paper_suite_command.cpp) and
 // --suite iterations (SAH cost against k-means' Lloyd iterations for several k, the
 // paper's stabilisation figure).
 #include <fmt/format.h>
 
-#include <fstream>
-#include <sstream>
-
+#include "adapters/bench/build_report.h"
+#include "adapters/bench/measure.h"
 #include "commands.h"
-#include "measure.h"
 #include "progress.h"
 #include "render_options.h"
-#include "report.h"
 #include "run_options.h"
 
 namespace kmbvh {
@@ -28,20 +25,23 @@ void add_bench_command(CLI::App& app, BenchCommand& c) {
   cmd->add_option("--reference", c.reference, "the builder build-time ratios are taken against");
   cmd->add_option("--csv", c.csv_path, "also write the rows to this CSV file");
   add_run_options(*cmd, c.run);
-  cmd->add_option("--suite", c.suite,
-                  "paper: time to image with the path tracer for every builder and Embree end to end (add "
-                  "embree-scene to --builders to choose it); iterations: SAH cost against Lloyd iterations")
-      ->check(CLI::IsMember({"paper", "iterations"}));
+  add_choice(*cmd, "--suite", c.suite,
+             std::map<std::string, BenchSuite>{{"builds", BenchSuite::Builds},
+                                               {"paper", BenchSuite::Paper},
+                                               {"iterations", BenchSuite::Iterations}},
+             "builds (the default); paper: time to image with the path tracer for every builder and Embree end to "
+             "end (add embree-scene to --builders to choose it); iterations: SAH cost against Lloyd iterations");
   cmd->add_option("--markdown", c.markdown_path, "--suite paper: also write the tables as Markdown to this file");
   PaperSuiteOptions& p = c.paper;
   cmd->add_option("--spp-lq", p.spp_lq, "--suite paper: samples per pixel of LQ images");
   cmd->add_option("--spp-hq", p.spp_hq, "--suite paper: samples per pixel of HQ images");
-  cmd->add_option("--quality", p.qualities, "--suite paper: lq, hq or lq,hq");
+  add_choice_list(*cmd, "--quality", p.qualities, names_of({RenderQuality::Lq, RenderQuality::Hq}),
+                  "--suite paper: lq, hq or lq,hq");
   cmd->add_flag("--project-hq", p.project_hq,
                 "--suite paper: HQ times from LQ's time per sample pass instead of rendering HQ (marked projected)");
   cmd->add_option("--time-limit", p.time_limit_s, "--suite paper: start no builder after this many seconds")
       ->check(CLI::NonNegativeNumber);
-  cmd->add_option("--views", p.views, "--suite paper: which views of each scene, a list of indices or all");
+  add_index_list(*cmd, "--views", p.views, "--suite paper: which views of each scene, a list of indices or all");
   cmd->add_option("--images", p.images_dir, "--suite paper: also write each rendered view as PNG into this folder");
   add_image_options(*cmd, p.render);
   cmd->add_option("--ks", c.ks, "--suite iterations: the cluster counts k");
@@ -74,7 +74,7 @@ std::vector<BuilderConfig> iteration_grid(const BenchCommand& c) {
   for (const uint32_t k : parse_counts(c.ks, "--ks"))
     for (const uint32_t i : parse_counts(c.iterations, "--iterations")) {
       BuilderOptions o = c.options;
-      o.builder = "kmeans";
+      o.builder = "kmeans";  // parsed by builder_config, as --builder is
       o.k = k;
       o.p = k >= 64 ? 30 : k >= 32 ? 20 : 5;
       o.i = i;
@@ -90,10 +90,10 @@ std::vector<BuilderConfig> iteration_grid(const BenchCommand& c) {
 }  // namespace
 
 int run_bench(const BenchCommand& c) {
-  if (c.suite == "paper") return run_paper_suite(c);
+  if (c.suite == BenchSuite::Paper) return run_bench_paper(c);
   apply_run_options(c.run);
   const std::vector<BuilderConfig> configs =
-      c.suite == "iterations" ? iteration_grid(c) : builder_configs(c.builders, c.options, c.run);
+      c.suite == BenchSuite::Iterations ? iteration_grid(c) : builder_configs(c.builders, c.options, c.run);
 
   Progress progress(c.run.quiet);
   std::vector<std::vector<Measurement>> tables;
@@ -120,21 +120,15 @@ int run_bench(const BenchCommand& c) {
 
   bool all_valid = true;
   nlohmann::json json = nlohmann::json::array();
-  std::ofstream csv;
-  if (!c.csv_path.empty()) {
-    csv.open(c.csv_path);
-    if (!csv) throw std::invalid_argument(fmt::format("{}: cannot be written", c.csv_path));
-    csv << csv_header() << "\n";
-  }
   for (const auto& rows : tables) {
-    if (!c.run.json) print_scene_table(rows, c.reference);
+    if (!c.run.json) fmt::print("{}", scene_report(rows, c.reference));
     for (const Measurement& m : rows) {
       all_valid = all_valid && m.validation.ok();
       json.push_back(to_json(m));
-      if (csv.is_open()) csv << csv_row(m, rows, c.reference) << "\n";
     }
   }
   if (c.run.json) fmt::print("{}\n", json.dump(2));
+  if (!c.csv_path.empty()) write_text_file(c.csv_path, bench_csv_table(tables, c.reference).csv());
   return all_valid ? kExitOk : kExitInvalidTree;
 }
 

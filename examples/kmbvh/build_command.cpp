@@ -1,10 +1,10 @@
 // kmbvh build SCENE --builder B ...: one builder on one scene, measured and validated.
 #include <fmt/format.h>
 
+#include "adapters/bench/build_report.h"
+#include "adapters/bench/measure.h"
 #include "commands.h"
-#include "measure.h"
 #include "progress.h"
-#include "report.h"
 #include "run_options.h"
 
 namespace kmbvh {
@@ -33,7 +33,7 @@ int run_build(const BuildCommand& c) {
   if (c.run.json)
     fmt::print("{}\n", to_json(m).dump(2));
   else
-    print_measurement(m);
+    fmt::print("{}", measurement_text(m));
   return m.validation.ok() ? kExitOk : kExitInvalidTree;
 }
 

@@ -3,9 +3,14 @@
 
 #include <CLI/CLI.hpp>
 
-#include "cuda/binary/binary_params.h"
 #include <string>
 #include <vector>
+
+#include "adapters/out/tracer.h"
+#include "adapters/rays/ray_sets.h"
+#include "cuda/binary/binary_params.h"
+#include "cuda/core/backend.h"
+#include "cuda/kmeans/params.h"
 
 namespace kmbvh {
 
@@ -19,7 +24,7 @@ struct RunOptions {
   int warmup = 1;
   bool quiet = false;
   bool json = false;
-  std::string backend = "cpu";
+  Backend backend = Backend::Cpu;
 };
 
 struct BuilderOptions {
@@ -29,7 +34,7 @@ struct BuilderOptions {
   CLI::Option *k_opt = nullptr, *p_opt = nullptr, *i_opt = nullptr;
   uint32_t max_leaf_size = 8;
   uint32_t seed = 1;
-  std::string metric = "means";
+  ClusterMetric metric = ClusterMetric::Means;
   bool wide = false;
   bool adaptive = false, until_stable = false;
   float settle = 0.0f;
@@ -44,10 +49,13 @@ struct BuildCommand {
   RunOptions run;
 };
 
+// The paper's two image qualities (docs/design.md §6): LQ 8 samples per pixel, HQ 128.
+enum class RenderQuality { Lq, Hq };
+
 // kmbvh render [SCENE]: the path tracer over one builder's tree, or Embree's.
 struct RenderOptions {
-  std::string layout = "bvh8";
-  std::string quality = "lq";  // lq: 8 samples per pixel, hq: 128 (docs/design.md §6)
+  Layout layout = Layout::Bvh8;
+  RenderQuality quality = RenderQuality::Lq;
   uint32_t spp = 0;            // overrides the quality's
   uint32_t width = 1024, height = 768;
   uint32_t seed = 1;
@@ -57,12 +65,18 @@ struct RenderOptions {
 // kmbvh bench --suite paper: the paper's evaluation, time to image.
 struct PaperSuiteOptions {
   uint32_t spp_lq = 8, spp_hq = 128;
-  std::string qualities = "lq,hq";  // which to run
+  std::vector<RenderQuality> qualities{RenderQuality::Lq, RenderQuality::Hq};  // which to run
   bool project_hq = false;          // HQ times from LQ's time per sample pass instead of rendering HQ
   double time_limit_s = 0;          // start no system after this many seconds (0: no limit)
-  std::string views = "all";        // which views: a comma-separated list of indices, or all
+  std::vector<int> views;           // which views (empty: all)
   std::string images_dir;           // also write every rendered view as PNG here
   RenderOptions render;             // layout, size, seed, views file
+};
+
+enum class BenchSuite {
+  Builds,      // every builder's build: time, SAH cost, memory, validity
+  Paper,       // the paper's evaluation: time to image
+  Iterations,  // SAH cost against k-means' Lloyd iterations, for several k
 };
 
 struct BenchCommand {
@@ -71,7 +85,7 @@ struct BenchCommand {
   std::string reference = "embree-medium";
   std::string csv_path;
   std::string markdown_path;
-  std::string suite;        // "" (builds), "paper" (time to image) or "iterations" (SAH against Lloyd iterations)
+  BenchSuite suite = BenchSuite::Builds;
   PaperSuiteOptions paper;
   std::string ks = "8,16,32,64", iterations = "0,1,2,3,4,5,6,8,10,12,15";  // --suite iterations
   BuilderOptions options;   // the reference builders' own parameters
@@ -82,8 +96,8 @@ struct TraceCommand {
   std::string scene;
   BuilderOptions builder;
   RunOptions run;
-  std::string layouts = "bvh8";  // comma-separated, or "all"
-  std::string rays = "all";      // primary, shadow, diffuse, or all
+  std::vector<Layout> layouts{Layout::Bvh8};
+  std::vector<RayKind> rays{RayKind::Primary, RayKind::Shadow, RayKind::Diffuse};
   size_t count = 100000;         // rays of each kind
   uint32_t ray_seed = 7;
   bool compare_embree = false;
@@ -107,8 +121,8 @@ struct RenderCommand {
   BuilderOptions builder;
   RunOptions run{0, 1, 0};  // one timed build, no warm-up: the image is what takes time
   RenderOptions render;
-  std::string traversal = "kmbvh";  // or embree: Embree's own scene and traversal
-  std::string views = "all";        // indices into the scene's views, or all
+  bool embree = false;              // --traversal embree: Embree's own scene and traversal
+  std::vector<int> views;           // indices into the scene's views (empty: all)
   std::string out_dir = "render";
 };
 
@@ -123,6 +137,6 @@ int run_bench(const BenchCommand& command);
 int run_stress(const StressCommand& command);
 int run_trace(const TraceCommand& command);
 int run_render(const RenderCommand& command);
-int run_paper_suite(const BenchCommand& command);
+int run_bench_paper(const BenchCommand& command);  // bench --suite paper (paper_suite_command.cpp)
 
 }  // namespace kmbvh

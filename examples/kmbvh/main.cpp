@@ -9,7 +9,7 @@
 #include <new>
 #include <stdexcept>
 
-#include "adapters/in/triangle_scene.h"
+#include "adapters/triangles/triangle_scene.h"
 #include "commands.h"
 #include "kmbvh/version.h"
 

@@ -6,12 +6,13 @@
 #include <filesystem>
 #include <nlohmann/json.hpp>
 
-#include "adapters/out/image_file.h"
+#include "adapters/bench/render_run.h"
+#include "adapters/bench/table.h"
+#include "adapters/render/image_file.h"
 #include "commands.h"
 #include "cuda/core/threads.h"
 #include "progress.h"
 #include "render_options.h"
-#include "render_run.h"
 #include "run_options.h"
 
 namespace kmbvh {
@@ -23,11 +24,12 @@ void add_render_command(CLI::App& app, RenderCommand& c) {
   cmd->add_option("scene", c.scene, "glTF/OBJ file or a scene name in $KMBVH_SCENES (default: the embedded scene)");
   add_builder_options(*cmd, c.builder);
   add_image_options(*cmd, c.render);
-  cmd->add_option("--quality", c.render.quality, "lq (8 samples per pixel) or hq (128)")->check(CLI::IsMember({"lq", "hq"}));
+  add_choice(*cmd, "--quality", c.render.quality, names_of({RenderQuality::Lq, RenderQuality::Hq}),
+             "lq (8 samples per pixel) or hq (128)");
   cmd->add_option("--spp", c.render.spp, "samples per pixel, instead of the quality's")->check(CLI::PositiveNumber);
-  cmd->add_option("--traversal", c.traversal, "kmbvh (the builder's tree) or embree (Embree's own scene; no --builder)")
-      ->check(CLI::IsMember({"kmbvh", "embree"}));
-  cmd->add_option("--views", c.views, "which views: a comma-separated list of indices, or all");
+  add_choice(*cmd, "--traversal", c.embree, std::map<std::string, bool>{{"kmbvh", false}, {"embree", true}},
+             "kmbvh (the builder's tree) or embree (Embree's own scene; no --builder)");
+  add_index_list(*cmd, "--views", c.views, "which views: a comma-separated list of indices, or all");
   cmd->add_option("--out", c.out_dir, "folder for the images (SCENE-SYSTEM-viewN.png and .exr)");
   add_run_options(*cmd, c.run);
 }
@@ -35,10 +37,10 @@ void add_render_command(CLI::App& app, RenderCommand& c) {
 int run_render(const RenderCommand& c) {
   apply_run_options(c.run);
   RenderSystem system;
-  system.embree = c.traversal == "embree";
+  system.embree = c.embree;
   if (!system.embree) {
     system.config = builder_config(c.builder, c.run);
-    system.layout = parse_layout(c.render.layout);
+    system.layout = c.render.layout;
   }
   const RenderSettings settings = render_settings(c.render);
   Progress progress(c.run.quiet);
@@ -47,7 +49,7 @@ int run_render(const RenderCommand& c) {
   progress.update("looking at the scene: room or object");
   const RenderScene look = prepare_render_scene(scene.geometry, scene.prims, float(settings.width) / float(settings.height),
                                                 scene.path, c.render.views_file);
-  const std::vector<int> views = parse_views(c.views, look.views.size());
+  const std::vector<int> views = chosen_views(c.views, look.views.size(), scene.name);
   std::error_code ec;
   std::filesystem::create_directories(c.out_dir, ec);
   if (ec) throw std::invalid_argument(fmt::format("{}: cannot be made ({})", c.out_dir, ec.message()));
@@ -57,8 +59,9 @@ int run_render(const RenderCommand& c) {
   options.warmup = c.run.warmup;
   options.progress = [&](const std::string& message) { progress.update(message); };
   const PreparedSystem prepared(scene, look, system, options);
-  const std::string stem = fmt::format("{}/{}-{}", c.out_dir, slug(scene_stem(scene.name)),
-                                       slug(system.embree ? system.label() : system.label() + " " + c.render.layout));
+  const std::string layout = system.embree ? "embree" : to_string(system.layout);
+  const std::string stem =
+      c.out_dir + "/" + image_stem(scene.name, system.embree ? system.label() : system.label() + " " + layout);
   std::vector<ViewRender> renders;
   Json view_rows = Json::array();
   for (const int v : views) {
@@ -88,8 +91,8 @@ int run_render(const RenderCommand& c) {
              {"scene_kind", to_string(look.kind)},
              {"views_from", look.views_source},
              {"system", system.label()},
-             {"traversal", c.traversal},
-             {"layout", system.embree ? "embree" : c.render.layout},
+             {"traversal", system.embree ? "embree" : "kmbvh"},
+             {"layout", layout},
              {"threads", thread_count()},
              {"width", settings.width},
              {"height", settings.height},
@@ -106,17 +109,18 @@ int run_render(const RenderCommand& c) {
   } else {
     fmt::print("{} ({} triangles, {}; views from {}) · {} · {} threads · {}x{}, {} spp\n", scene.name, scene.triangles,
                to_string(look.kind), look.views_source,
-               system.embree ? "Embree's scene and traversal" : system.label() + " in " + c.render.layout,
+               system.embree ? "Embree's scene and traversal" : system.label() + " in " + layout,
                thread_count(), settings.width, settings.height, settings.spp);
     fmt::print("build {:.1f} ms{} · layout {:.1f} ms\n", prepared.build_ms(),
                prepared.measurement() ? fmt::format(" (SAH {:.1f})", prepared.measurement()->sah_cost) : "",
                prepared.layout_ms());
-    fmt::print("{:>4} {:>11} {:>10} {:>9} {:>12} {:>12}  {}\n", "view", "render ms", "trace ms", "Mrays/s", "rays",
-               "shadow rays", "image");
+    Table table({{"view"}, {"render ms"}, {"trace ms"}, {"Mrays/s"}, {"rays"}, {"shadow rays"}, {"image", Align::Left}});
     for (size_t i = 0; i < renders.size(); ++i)
-      fmt::print("{:>4} {:>11.1f} {:>10.1f} {:>9.2f} {:>12} {:>12}  {}\n", renders[i].view, renders[i].stats.render_ms,
-                 renders[i].stats.trace_ms, renders[i].stats.mrays_per_s(), renders[i].stats.rays,
-                 renders[i].stats.shadow_rays, view_rows[i]["png"].get<std::string>());
+      table.add_row({std::to_string(renders[i].view), fmt::format("{:.1f}", renders[i].stats.render_ms),
+                     fmt::format("{:.1f}", renders[i].stats.trace_ms), fmt::format("{:.2f}", renders[i].stats.mrays_per_s()),
+                     std::to_string(renders[i].stats.rays), std::to_string(renders[i].stats.shadow_rays),
+                     view_rows[i]["png"].get<std::string>()});
+    fmt::print("{}", table.text());
     fmt::print("time to image: {:.1f} ms (build + layout + mean render over {} view{})\n", tti, renders.size(),
                renders.size() == 1 ? "" : "s");
   }

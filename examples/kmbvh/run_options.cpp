@@ -11,11 +11,36 @@
 
 namespace kmbvh {
 
+const char* to_string(RenderQuality quality) { return quality == RenderQuality::Hq ? "hq" : "lq"; }
+
+CLI::Option* add_index_list(CLI::App& cmd, const std::string& flag, std::vector<int>& indices, const std::string& help) {
+  return cmd.add_option_function<std::string>(
+      flag,
+      [&indices, flag](const std::string& list) {
+        indices.clear();
+        if (list == "all") return;
+        for (const std::string& item : split_list(list)) {
+          size_t used = 0;
+          int index = -1;
+          try {
+            index = std::stoi(item, &used);
+          } catch (const std::exception&) {
+          }
+          if (used != item.size() || index < 0)
+            throw CLI::ValidationError(flag, fmt::format("'{}' is not an index (0, 1, ...)", item));
+          indices.push_back(index);
+        }
+        if (indices.empty()) throw CLI::ValidationError(flag, "no index given (a list of indices, or all)");
+      },
+      help);
+}
+
 void add_run_options(CLI::App& cmd, RunOptions& run) {
   cmd.add_option("--threads", run.threads, "CPU threads (0: all)")->check(CLI::NonNegativeNumber);
   cmd.add_option("--runs", run.runs, "timed runs; the median is reported")->check(CLI::PositiveNumber);
   cmd.add_option("--warmup", run.warmup, "untimed runs first")->check(CLI::NonNegativeNumber);
-  cmd.add_option("--backend", run.backend, "where k-means runs: cpu or cuda")->check(CLI::IsMember({"cpu", "cuda"}));
+  add_choice(cmd, "--backend", run.backend, names_of({Backend::Cpu, Backend::Cuda}),
+             "where the portable builders run: cpu or cuda");
   cmd.add_flag("--json", run.json, "print JSON instead of tables");
   cmd.add_flag("-q,--quiet", run.quiet, "no progress on stderr");
 }
@@ -29,7 +54,8 @@ void add_builder_options(CLI::App& cmd, BuilderOptions& b) {
   b.i_opt = cmd.add_option("--i", b.i, "k-means: Lloyd iterations (0 allowed)");
   cmd.add_option("--m,--max-leaf-size", b.max_leaf_size, "largest leaf");
   cmd.add_option("--seed", b.seed, "k-means: seed of the counter-based random draws");
-  cmd.add_option("--metric", b.metric, "k-means: means or medians")->check(CLI::IsMember({"means", "medians"}));
+  add_choice(cmd, "--metric", b.metric, names_of({ClusterMetric::Means, ClusterMetric::Medians}),
+             "k-means: means or medians");
   cmd.add_flag("--wide", b.wide, "k-means: emit the k-ary tree itself instead of binary treelets");
   b.adaptive_opt = cmd.add_flag("--adaptive", b.adaptive, "k-means: k and p per node from its size (--k, --p are caps)");
   b.until_stable_opt =
@@ -60,14 +86,12 @@ std::vector<std::string> split_list(const std::string& list) {
 
 void apply_run_options(const RunOptions& run) { set_thread_count(run.threads); }
 
-Backend backend_of(const RunOptions& run) { return run.backend == "cuda" ? Backend::Cuda : Backend::Cpu; }
-
 BuilderConfig builder_config(const BuilderOptions& o, const RunOptions& run) {
   BuilderConfig config = parse_builder(o.builder == "kmeans" ? "kmeans:" + o.preset : o.builder);
   config.max_leaf_size = o.max_leaf_size;
-  config.backend = backend_of(run);
+  config.backend = run.backend;
   config.binary = o.binary;
-  if (config.builder == "kmeans") {
+  if (config.builder == BuilderKind::Kmeans) {
     const auto given = [](const CLI::Option* opt) { return opt && opt->count() > 0; };
     const bool custom = given(o.k_opt) || given(o.p_opt) || given(o.i_opt) || given(o.adaptive_opt) ||
                         given(o.until_stable_opt) || given(o.settle_opt);
@@ -81,9 +105,7 @@ BuilderConfig builder_config(const BuilderOptions& o, const RunOptions& run) {
     config.kmeans.seed = o.seed;
     config.kmeans.wide = o.wide;
     config.kmeans.cpu_subtrees = !o.level_loop;
-    const auto metric = parse_metric(o.metric);
-    if (!metric) throw std::invalid_argument(fmt::format("unknown metric '{}' (means or medians)", o.metric));
-    config.kmeans.metric = *metric;
+    config.kmeans.metric = o.metric;
   }
   check_config(config);
   return config;
@@ -102,7 +124,7 @@ std::vector<BuilderConfig> builder_configs(const std::string& list, const Builde
       add(spec);
       continue;
     }
-    for (const BuilderConfig& b : all_builders()) add(b.builder == "kmeans" ? b.preset : b.builder);
+    for (const BuilderConfig& b : all_builders()) add(b.builder == BuilderKind::Kmeans ? b.preset : to_string(b.builder));
   }
   if (configs.empty()) throw std::invalid_argument("--builders: no builder given");
   return configs;

@@ -5,67 +5,15 @@
 #include <fmt/format.h>
 
 #include <algorithm>
-#include <fstream>
 #include <map>
 #include <nlohmann/json.hpp>
 
+#include "adapters/bench/stress.h"
 #include "commands.h"
 #include "progress.h"
 #include "run_options.h"
-#include "stress.h"
 
 namespace kmbvh {
-namespace {
-
-nlohmann::ordered_json to_json(const StressRow& r) {
-  return {{"case", r.scene},           {"what", r.what},
-          {"triangles", r.triangles},  {"dropped", r.dropped},
-          {"builder", r.builder},      {"kmbvh", r.kmbvh},
-          {"outcome", r.outcome},      {"message", r.message},
-          {"build_ms", r.build_ms},    {"sah_cost", r.sah_cost},
-          {"sah_over_sweep", r.sah_over_sweep}, {"max_depth", r.max_depth},
-          {"max_leaf_size", r.max_leaf_size},   {"rays", r.rays},
-          {"mismatches", r.mismatches}};
-}
-
-void print_case(const std::vector<StressRow>& rows) {
-  const StressRow& first = rows.front();
-  fmt::print("\n{}: {} ({} triangles{})\n", first.scene, first.what, first.triangles,
-             first.dropped ? fmt::format(", {} left out", first.dropped) : "");
-  fmt::print("{:<22} {:<9} {:>10} {:>10} {:>7} {:>6} {:>5} {:>9}\n", "builder", "outcome", "build ms", "SAH", "/sweep",
-             "depth", "leaf", "mismatch");
-  for (const StressRow& r : rows) {
-    fmt::print("{:<22} {:<9} {:>10.2f} {:>10.2f} {:>7.3f} {:>6} {:>5} {:>9}\n", r.builder, r.outcome, r.build_ms,
-               r.sah_cost, r.sah_over_sweep, r.max_depth, r.max_leaf_size, r.mismatches);
-    if (!r.ok()) fmt::print("  {}\n", r.message);
-  }
-}
-
-// Cases down, builders across; each cell the SAH cost over sweep-sah's, or what failed.
-std::string markdown(const std::vector<std::vector<StressRow>>& cases) {
-  std::string out = "| case | triangles |";
-  std::string rule = "|---|---:|";
-  for (const StressRow& r : cases.front()) {
-    out += fmt::format(" {} |", r.builder);
-    rule += "---:|";
-  }
-  out += "\n" + rule + "\n";
-  for (const auto& rows : cases) {
-    out += fmt::format("| {} | {} |", rows.front().scene, rows.front().triangles);
-    for (const StressRow& r : rows) {
-      if (!r.ok())
-        out += fmt::format(" **{}** |", r.outcome);
-      else if (r.sah_over_sweep > 0)
-        out += fmt::format(" {:.2f} |", r.sah_over_sweep);
-      else
-        out += " ok |";
-    }
-    out += "\n";
-  }
-  return out;
-}
-
-}  // namespace
 
 void add_stress_command(CLI::App& app, StressCommand& c) {
   CLI::App* cmd = app.add_subcommand("stress", "Every builder on generated scenes where builders fail: degenerate, "
@@ -108,7 +56,7 @@ int run_stress(const StressCommand& c) {
   nlohmann::ordered_json json = nlohmann::ordered_json::array();
   std::map<std::string, int> failures;
   for (const auto& rows : cases) {
-    if (!c.run.json) print_case(rows);
+    if (!c.run.json) fmt::print("{}", case_report(rows));
     for (const StressRow& r : rows) {
       json.push_back(to_json(r));
       if (!r.ok()) ++failures[r.builder];
@@ -116,11 +64,7 @@ int run_stress(const StressCommand& c) {
     }
   }
   if (c.run.json) fmt::print("{}\n", json.dump(2));
-  if (!c.markdown_path.empty()) {
-    std::ofstream out(c.markdown_path);
-    if (!out) throw std::invalid_argument(fmt::format("{}: cannot be written", c.markdown_path));
-    out << markdown(cases);
-  }
+  if (!c.markdown_path.empty()) write_text_file(c.markdown_path, stress_summary_table(cases).markdown());
   if (!c.run.json) {
     fmt::print("\n{} cases x {} builders: ", cases.size(), configs.size());
     if (failures.empty()) fmt::print("every builder completed every case\n");

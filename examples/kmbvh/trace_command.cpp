@@ -8,6 +8,7 @@
 #include <nlohmann/json.hpp>
 #include <optional>
 
+#include "adapters/bench/measure.h"
 #include "adapters/embree/embree_scene.h"
 #include "adapters/out/cpu_isa.h"
 #include "adapters/out/tracer.h"
@@ -16,7 +17,6 @@
 #include "commands.h"
 #include "cuda/core/threads.h"
 #include "cuda/metrics/sah.h"
-#include "measure.h"
 #include "progress.h"
 #include "run_options.h"
 
@@ -24,22 +24,6 @@ namespace kmbvh {
 namespace {
 
 using Json = nlohmann::ordered_json;
-
-std::vector<Layout> parse_layouts(const std::string& list) {
-  if (list == "all") return {Layout::Bvh2, Layout::Bvh4, Layout::Bvh8};
-  std::vector<Layout> out;
-  for (const std::string& name : split_list(list)) out.push_back(parse_layout(name));
-  if (out.empty()) throw std::invalid_argument("--layout: no layout given");
-  return out;
-}
-
-std::vector<RayKind> parse_kinds(const std::string& list) {
-  if (list == "all") return {RayKind::Primary, RayKind::Shadow, RayKind::Diffuse};
-  std::vector<RayKind> out;
-  for (const std::string& name : split_list(list)) out.push_back(parse_ray_kind(name));
-  if (out.empty()) throw std::invalid_argument("--rays: no ray kind given");
-  return out;
-}
 
 // Wall time of one call, in seconds.
 double seconds_of(const std::function<void()>& f) {
@@ -154,8 +138,10 @@ void add_trace_command(CLI::App& app, TraceCommand& c) {
   CLI::App* cmd = app.add_subcommand("trace", "Trace rays through kmbvh's traversal of a builder's tree, against Embree's");
   cmd->add_option("scene", c.scene, "glTF/OBJ file or a scene name in $KMBVH_SCENES (default: the embedded scene)");
   add_builder_options(*cmd, c.builder);
-  cmd->add_option("--layout", c.layouts, "bvh2 (the portable kernel), bvh4, bvh8 (CPU SIMD), a list, or all");
-  cmd->add_option("--rays", c.rays, "primary, shadow, diffuse, a list, or all");
+  add_choice_list(*cmd, "--layout", c.layouts, names_of({Layout::Bvh2, Layout::Bvh4, Layout::Bvh8}),
+                  "bvh2 (the portable kernel), bvh4, bvh8 (CPU SIMD), a list, or all");
+  add_choice_list(*cmd, "--rays", c.rays, names_of({RayKind::Primary, RayKind::Shadow, RayKind::Diffuse}),
+                  "primary, shadow, diffuse, a list, or all");
   cmd->add_option("--count", c.count, "rays of each kind")->check(CLI::PositiveNumber);
   cmd->add_option("--ray-seed", c.ray_seed, "seed of the rays' random draws");
   cmd->add_flag("--compare-embree", c.compare_embree, "trace the same rays with Embree and count every difference");
@@ -166,8 +152,8 @@ void add_trace_command(CLI::App& app, TraceCommand& c) {
 int run_trace(const TraceCommand& c) {
   apply_run_options(c.run);
   const BuilderConfig config = builder_config(c.builder, c.run);
-  const std::vector<Layout> layouts = parse_layouts(c.layouts);
-  const std::vector<RayKind> kinds = parse_kinds(c.rays);
+  const std::vector<Layout>& layouts = c.layouts;
+  const std::vector<RayKind>& kinds = c.rays;
   for (const Layout layout : layouts)
     if (layout != Layout::Bvh2) traversal_isa();  // a KMBVH_ISA this CPU cannot run fails now, not after the build
   Progress progress(c.run.quiet);

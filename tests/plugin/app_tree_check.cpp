@@ -4,8 +4,8 @@
 
 #include <algorithm>
 
-#include "adapters/embree/build_primitives.h"
-#include "adapters/in/triangle_scene.h"
+#include "adapters/builder_api/build_primitives.h"
+#include "adapters/triangles/triangle_scene.h"
 
 namespace kmbvh::test {
 namespace {

@@ -7,7 +7,7 @@
 #include <string>
 #include <vector>
 
-#include "adapters/in/triangle_scene.h"
+#include "adapters/triangles/triangle_scene.h"
 #include "examples/embree_swap/app_bvh.h"
 
 namespace kmbvh::test {

@@ -7,7 +7,7 @@
 #include <limits>
 #include <vector>
 
-#include "adapters/in/triangle_scene.h"
+#include "adapters/triangles/triangle_scene.h"
 #include "cuda/core/bvh.h"
 #include "cuda/traversal/ray.h"
 

@@ -2,6 +2,9 @@
 
 #include <fmt/format.h>
 
+#include <cctype>
+#include <stdexcept>
+
 #include "adapters/render/traversals.h"
 
 namespace kmbvh {
@@ -51,6 +54,23 @@ double mean_render_ms(const std::vector<ViewRender>& views) {
   double sum = 0;
   for (const ViewRender& v : views) sum += v.stats.render_ms;
   return sum / double(views.size());
+}
+
+std::vector<int> chosen_views(const std::vector<int>& wanted, size_t count, const std::string& scene) {
+  std::vector<int> views = wanted;
+  if (views.empty())
+    for (size_t v = 0; v < count; ++v) views.push_back(int(v));
+  for (const int v : views)
+    if (v < 0 || size_t(v) >= count)
+      throw std::invalid_argument(fmt::format("{} has no view {} (its views are 0 to {})", scene, v, int(count) - 1));
+  return views;
+}
+
+std::string image_stem(const std::string& scene_name, const std::string& label) {
+  std::string stem = scene_name.substr(0, scene_name.rfind('.')) + "-" + label;
+  for (char& c : stem)
+    if (!std::isalnum(static_cast<unsigned char>(c)) && c != '-' && c != '.') c = '-';
+  return stem;
 }
 
 }  // namespace kmbvh

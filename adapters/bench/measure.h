@@ -9,7 +9,7 @@
 #include <vector>
 
 #include "adapters/builder_registry.h"
-#include "adapters/in/triangle_scene.h"
+#include "adapters/triangles/triangle_scene.h"
 #include "cuda/metrics/tree_stats.h"
 #include "cuda/metrics/validate.h"
 

@@ -65,7 +65,7 @@ void compare_with_embree(const Bvh& bvh, const PrimitiveSet& prims, const Triang
     }
   }
   if (row.mismatches) {
-    row.outcome = "mismatch";
+    row.outcome = StressOutcome::Mismatch;
     row.message = fmt::format("hits differ from Embree's: {}; first: {}", fmt::join(where, ", "), first);
   }
 }
@@ -90,14 +90,14 @@ StressRow run_one(const StressCase& c, const PrimitiveSet& prims, size_t dropped
     row.max_depth = stats.max_depth;
     row.max_leaf_size = stats.max_leaf_size;
     if (!report.ok()) {
-      row.outcome = "invalid";
+      row.outcome = StressOutcome::Invalid;
       row.message = report.summary();
       return row;
     }
-    row.outcome = "ok";
+    row.outcome = StressOutcome::Ok;
     compare_with_embree(bvh, prims, c.scene, stats.max_arity, ref, row);
   } catch (const std::exception& e) {
-    row.outcome = "error";
+    row.outcome = StressOutcome::Error;
     row.message = e.what();
   }
   return row;
@@ -123,11 +123,66 @@ std::vector<StressRow> run_stress_case(const std::string& name, const std::vecto
   for (const BuilderConfig& config : builders) {
     say(fmt::format("{}: {}", name, config.label()));
     rows.push_back(run_one(c, prims, dropped, config, ref));
-    if (config.builder == "sweep-sah" && rows.back().ok()) sweep_sah = rows.back().sah_cost;
+    if (config.builder == BuilderKind::SweepSah && rows.back().ok()) sweep_sah = rows.back().sah_cost;
   }
   for (StressRow& row : rows)
-    if (sweep_sah > 0 && row.outcome != "error") row.sah_over_sweep = row.sah_cost / sweep_sah;
+    if (sweep_sah > 0 && row.outcome != StressOutcome::Error) row.sah_over_sweep = row.sah_cost / sweep_sah;
   return rows;
+}
+
+const char* to_string(StressOutcome outcome) {
+  switch (outcome) {
+    case StressOutcome::Ok: return "ok";
+    case StressOutcome::Error: return "error";
+    case StressOutcome::Invalid: return "invalid";
+    case StressOutcome::Mismatch: return "mismatch";
+  }
+  return "unknown";
+}
+
+nlohmann::ordered_json to_json(const StressRow& r) {
+  return {{"case", r.scene},           {"what", r.what},
+          {"triangles", r.triangles},  {"dropped", r.dropped},
+          {"builder", r.builder},      {"kmbvh", r.kmbvh},
+          {"outcome", to_string(r.outcome)}, {"message", r.message},
+          {"build_ms", r.build_ms},    {"sah_cost", r.sah_cost},
+          {"sah_over_sweep", r.sah_over_sweep}, {"max_depth", r.max_depth},
+          {"max_leaf_size", r.max_leaf_size},   {"rays", r.rays},
+          {"mismatches", r.mismatches}};
+}
+
+std::string case_report(const std::vector<StressRow>& rows) {
+  if (rows.empty()) return "";
+  const StressRow& first = rows.front();
+  Table table({{"builder", Align::Left}, {"outcome", Align::Left}, {"build ms"}, {"SAH"}, {"/sweep"}, {"depth"},
+               {"leaf"}, {"mismatch"}});
+  std::string failures;
+  for (const StressRow& r : rows) {
+    table.add_row({r.builder, to_string(r.outcome), fmt::format("{:.2f}", r.build_ms), fmt::format("{:.2f}", r.sah_cost),
+                   fmt::format("{:.3f}", r.sah_over_sweep), std::to_string(r.max_depth),
+                   std::to_string(r.max_leaf_size), std::to_string(r.mismatches)});
+    if (!r.ok()) failures += fmt::format("  {}: {}\n", r.builder, r.message);
+  }
+  return fmt::format("\n{}: {} ({} triangles{})\n", first.scene, first.what, first.triangles,
+                     first.dropped ? fmt::format(", {} left out", first.dropped) : "") +
+         table.text() + failures;
+}
+
+Table stress_summary_table(const std::vector<std::vector<StressRow>>& cases) {
+  std::vector<Column> columns{{"case", Align::Left}, {"triangles"}};
+  if (!cases.empty())
+    for (const StressRow& r : cases.front()) columns.push_back({r.builder});
+  Table table(std::move(columns));
+  for (const auto& rows : cases) {
+    if (rows.empty()) continue;
+    std::vector<std::string> cells{rows.front().scene, std::to_string(rows.front().triangles)};
+    for (const StressRow& r : rows)
+      cells.push_back(!r.ok()                ? fmt::format("**{}**", to_string(r.outcome))
+                      : r.sah_over_sweep > 0 ? fmt::format("{:.2f}", r.sah_over_sweep)
+                                             : "ok");
+    table.add_row(std::move(cells));
+  }
+  return table;
 }
 
 }  // namespace kmbvh

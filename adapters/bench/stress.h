@@ -6,11 +6,13 @@
 
 #include <cstddef>
 #include <functional>
+#include <nlohmann/json.hpp>
 #include <string>
 #include <vector>
 
 #include "adapters/builder_registry.h"
 #include "adapters/in/generated_scenes.h"
+#include "table.h"
 
 namespace kmbvh {
 
@@ -20,6 +22,15 @@ struct StressOptions {
   std::function<void(const std::string&)> progress;  // optional
 };
 
+// What became of one builder on one case.
+enum class StressOutcome {
+  Ok,        // a valid tree with Embree's hits
+  Error,     // the builder threw
+  Invalid,   // the tree failed validation
+  Mismatch,  // the tree's hits differ from Embree's
+};
+const char* to_string(StressOutcome outcome);  // "ok", "error", "invalid", "mismatch"
+
 struct StressRow {
   std::string scene;    // the case's name
   std::string what;
@@ -27,7 +38,7 @@ struct StressRow {
   size_t dropped = 0;    // left out for a non-finite vertex
   std::string builder;   // the builder's label
   bool kmbvh = true;     // kmbvh's own implementation (every builder but Embree's)
-  std::string outcome;   // "ok", "error" (threw), "invalid" (tree), "mismatch" (hits)
+  StressOutcome outcome = StressOutcome::Error;
   std::string message;   // the error, the validation's summary or the mismatches, in words
   double build_ms = 0;
   double sah_cost = 0;
@@ -37,11 +48,20 @@ struct StressRow {
   size_t rays = 0;        // traced per layout, all kinds together
   size_t mismatches = 0;  // against Embree, every layout and kind
 
-  bool ok() const { return outcome == "ok"; }
+  bool ok() const { return outcome == StressOutcome::Ok; }
 };
 
 // One case, every builder given; rows in the builders' order.
 std::vector<StressRow> run_stress_case(const std::string& name, const std::vector<BuilderConfig>& builders,
                                        const StressOptions& options);
+
+nlohmann::ordered_json to_json(const StressRow& row);
+
+// One case as `kmbvh stress` prints it: a title line, a row per builder, then each failure in words.
+std::string case_report(const std::vector<StressRow>& rows);
+
+// Cases down, builders across (those of the first case); each cell the SAH cost over
+// sweep-sah's, "ok" where there is no sweep-sah row, or the failure in bold.
+Table stress_summary_table(const std::vector<std::vector<StressRow>>& cases);
 
 }  // namespace kmbvh

@@ -1,6 +1,6 @@
 #include "embree_callbacks.h"
 
-#include "adapters/embree/build_primitives.h"
+#include "adapters/builder_api/build_primitives.h"
 
 #include <omp.h>
 

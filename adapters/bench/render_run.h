@@ -59,4 +59,13 @@ class PreparedSystem {
 // The mean over views of their render times: what docs/design.md §6 averages over 3 views.
 double mean_render_ms(const std::vector<ViewRender>& views);
 
+// The views `wanted` of a scene that has `count` (empty: all of them); throws
+// std::invalid_argument naming the scene and a view it lacks.
+std::vector<int> chosen_views(const std::vector<int>& wanted, size_t count, const std::string& scene);
+
+// Where a system's images of a scene start their file names: "conference.glb", "kmeans Q2
+// bvh8" -> "conference-kmeans-Q2-bvh8" (the scene without its extension; spaces and
+// punctuation become dashes).
+std::string image_stem(const std::string& scene_name, const std::string& label);
+
 }  // namespace kmbvh
