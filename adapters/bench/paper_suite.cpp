@@ -13,10 +13,9 @@ namespace kmbvh {
 namespace {
 
 using Json = nlohmann::ordered_json;
-constexpr const char* kEmbreeScene = "embree-scene";
 
 // The builder's name of a row, "embree-scene" for Embree end to end.
-std::string builder_name(const SuiteRow& r) { return r.system.embree ? kEmbreeScene : to_string(r.system.config.builder); }
+std::string builder_name(const SuiteRow& r) { return r.system.embree ? kEmbreeSceneName : to_string(r.system.config.builder); }
 
 // The paper's Table 1 column of a row, if it has one.
 std::optional<PaperFigures> paper_cell(const SuiteRow& r) {

@@ -19,6 +19,9 @@
 
 namespace kmbvh {
 
+// The builder's name of Embree end to end in the suite's rows and its --builders list.
+inline constexpr const char* kEmbreeSceneName = "embree-scene";
+
 struct PaperSuitePlan {
   std::vector<RenderSystem> systems;
   std::optional<RenderSettings> lq, hq;  // the qualities to run (at least one)

@@ -27,12 +27,6 @@ const char* to_string(Layout layout) {
   return "?";
 }
 
-Layout parse_layout(const std::string& name) {
-  for (Layout l : {Layout::Bvh2, Layout::Bvh4, Layout::Bvh8})
-    if (name == to_string(l)) return l;
-  throw std::invalid_argument("unknown layout '" + name + "' (bvh2, bvh4 or bvh8)");
-}
-
 uint32_t layout_width(Layout layout) { return layout == Layout::Bvh2 ? 2 : layout == Layout::Bvh4 ? 4 : 8; }
 
 Tracer::Tracer(const Bvh& bvh, const PrimitiveSet& prims, const TriangleScene& scene, Layout layout, Backend backend,

@@ -19,8 +19,6 @@ namespace kmbvh {
 
 enum class Layout { Bvh2, Bvh4, Bvh8 };
 const char* to_string(Layout layout);
-// "bvh2", "bvh4" or "bvh8"; throws std::invalid_argument otherwise.
-Layout parse_layout(const std::string& name);
 uint32_t layout_width(Layout layout);
 
 class Tracer {

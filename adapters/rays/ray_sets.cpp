@@ -44,12 +44,6 @@ const char* to_string(RayKind kind) {
   return "?";
 }
 
-RayKind parse_ray_kind(const std::string& name) {
-  for (RayKind k : {RayKind::Primary, RayKind::Shadow, RayKind::Diffuse})
-    if (name == to_string(k)) return k;
-  throw std::invalid_argument("unknown ray kind '" + name + "' (primary, shadow, diffuse or all)");
-}
-
 Query query_for(RayKind kind) { return kind == RayKind::Shadow ? Query::Any : Query::Closest; }
 
 const std::vector<Ray>& RaySets::of(RayKind kind) const {

@@ -15,8 +15,6 @@ namespace kmbvh {
 
 enum class RayKind { Primary, Shadow, Diffuse };
 const char* to_string(RayKind kind);
-// "primary", "shadow" or "diffuse"; throws std::invalid_argument otherwise.
-RayKind parse_ray_kind(const std::string& name);
 
 // The query each kind is traced with: shadow rays ask for any hit, the others the closest.
 Query query_for(RayKind kind);

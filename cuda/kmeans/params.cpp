@@ -50,12 +50,6 @@ std::string to_string(ClusterMetric metric) {
   return metric == ClusterMetric::Means ? "means" : "medians";
 }
 
-std::optional<ClusterMetric> parse_metric(const std::string& name) {
-  if (name == "means" || name == "mean") return ClusterMetric::Means;
-  if (name == "medians" || name == "median") return ClusterMetric::Medians;
-  return std::nullopt;
-}
-
 std::string check_params(const KMeansParams& params) {
   if (params.k < 2 || params.k > KMeansParams::kMaxK)
     return fmt::format("k must be in [2, {}], got {}", KMeansParams::kMaxK, params.k);

@@ -43,7 +43,6 @@ struct KMeansParams {
 std::optional<KMeansParams> kmeans_preset(const std::string& name);
 const char* const* kmeans_preset_names();  // null-terminated list
 std::string to_string(ClusterMetric metric);
-std::optional<ClusterMetric> parse_metric(const std::string& name);
 
 // Empty when the parameters can be built with; else what is wrong, in words.
 std::string check_params(const KMeansParams& params);

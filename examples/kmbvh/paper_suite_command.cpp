@@ -20,7 +20,7 @@ std::vector<RenderSystem> suite_systems(const BenchCommand& c) {
   RenderSystem embree;
   embree.embree = true;
   for (const std::string& spec : split_list(c.builders)) {
-    if (spec == "embree-scene") {
+    if (spec == kEmbreeSceneName) {
       systems.push_back(embree);
       continue;
     }
