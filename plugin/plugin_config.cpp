@@ -24,6 +24,35 @@ uint32_t env_count(const char* name, uint32_t lo, uint32_t hi) {
   return uint32_t(x);
 }
 
+bool flag(const char* name) {
+  const std::string v = env(name);
+  if (v.empty() || v == "0") return false;
+  if (v == "1") return true;
+  throw std::invalid_argument(fmt::format("{}={}: expected 0 or 1", name, v));
+}
+
+AbConfig read_ab_config() {
+  AbConfig ab;
+  ab.on = flag("KMBVH_AB");
+  if (const uint32_t n = env_count("KMBVH_AB_SAMPLE", 1, 1u << 30)) ab.sample = n;
+  const std::string answer = env("KMBVH_AB_ANSWER");
+  if (answer == "embree")
+    ab.embree_answers = true;
+  else if (!answer.empty() && answer != "kmbvh")
+    throw std::invalid_argument("KMBVH_AB_ANSWER=" + answer + ": expected kmbvh or embree");
+  ab.report = env("KMBVH_AB_REPORT");
+  const std::string perturb = env("KMBVH_AB_PERTURB");
+  if (perturb == "primitive")
+    ab.perturb = Perturbation::Primitive;
+  else if (perturb == "distance")
+    ab.perturb = Perturbation::Distance;
+  else if (perturb == "miss")
+    ab.perturb = Perturbation::Miss;
+  else if (!perturb.empty())
+    throw std::invalid_argument("KMBVH_AB_PERTURB=" + perturb + ": expected primitive, distance or miss");
+  return ab;
+}
+
 bool log_requested() { return !env("KMBVH_LOG").empty() && env("KMBVH_LOG") != "0"; }
 
 }  // namespace
@@ -55,6 +84,7 @@ PluginConfig read_plugin_config() {
   else if (!backend.empty() && backend != "cpu")
     throw std::invalid_argument("KMBVH_BACKEND=" + backend + ": expected cpu or cuda");
   c.log = log_requested();
+  c.ab = read_ab_config();
   return c;
 }
 

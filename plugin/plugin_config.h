@@ -5,6 +5,11 @@
 //   KMBVH_K, KMBVH_P, KMBVH_I   k-means parameters, overriding the preset's
 //   KMBVH_LOG=1    one line per build (and per scene) on stderr
 //   KMBVH_BACKEND  cpu (default) or cuda
+//   KMBVH_AB=1     A/B mode (plugin/README.md): queries and builds answered by both kmbvh and
+//                  Embree and compared; KMBVH_AB_SAMPLE=N compares 1 query in N,
+//                  KMBVH_AB_ANSWER=kmbvh|embree says whose answer the application gets,
+//                  KMBVH_AB_REPORT=FILE writes the report as JSON, KMBVH_AB_PERTURB (tests
+//                  only) spoils kmbvh's answers so the oracle can be seen to fail
 #pragma once
 
 #include <embree3/rtcore.h>
@@ -15,6 +20,18 @@
 
 namespace kmbvh::plugin {
 
+// How KMBVH_AB_PERTURB spoils kmbvh's answer to every compared query (tests only): a
+// wrong primitive (closest hits), t moved by 0.1% (closest hits), or every hit dropped.
+enum class Perturbation { None, Primitive, Distance, Miss };
+
+struct AbConfig {
+  bool on = false;
+  uint32_t sample = 1;          // 1 query in `sample` is compared
+  bool embree_answers = false;  // the application receives Embree's answers
+  std::string report;           // JSON report file; empty: the summary on stderr only
+  Perturbation perturb = Perturbation::None;
+};
+
 struct PluginConfig {
   bool pass_through = false;  // KMBVH_BUILDER=embree
   BuilderKind builder = BuilderKind::Kmeans;
@@ -22,6 +39,7 @@ struct PluginConfig {
   uint32_t k = 0, p = 0, i = 0;  // 0: the preset's
   Backend backend = Backend::Cpu;
   bool log = false;
+  AbConfig ab;
 };
 
 // Throws std::invalid_argument naming the variable and its bad value.

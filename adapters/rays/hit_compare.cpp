@@ -56,14 +56,14 @@ Meet meet(const TriangleScene& scene, uint32_t prim, const Ray& ray, double& t, 
 
 using Ground = ExactAnswers::Answer;
 
-Ground brute_force(const TriangleScene& scene, const Ray& ray) {
+Ground brute_force(const TriangleScene& scene, const Ray& ray, bool parallel) {
   // Whether a clear hit exists is reduced apart from its distance: OpenMP starts a min
   // reduction's private copies at the type's largest value, which libgomp takes as +inf
   // and libomp (clang) as DBL_MAX, so "nearest is infinite" cannot mean "no clear hit".
   double nearest = std::numeric_limits<double>::infinity();
   bool any = false, clear = false;
   const auto n = int64_t(scene.triangles.size());
-#pragma omp parallel for schedule(static) reduction(min : nearest) reduction(|| : any, clear) if (n >= 65536)
+#pragma omp parallel for schedule(static) reduction(min : nearest) reduction(|| : any, clear) if (parallel && n >= 65536)
   for (int64_t p = 0; p < n; ++p) {
     double t;
     const Meet m = meet(scene, uint32_t(p), ray, t);
@@ -149,6 +149,76 @@ void HitComparison::add(const HitComparison& o, size_t keep) {
     if (first.size() < keep) first.push_back(m);
 }
 
+ExactAnswers::Answer exact_answer(const TriangleScene& scene, const Ray& ray, bool parallel) {
+  return brute_force(scene, ray, parallel);
+}
+
+namespace detail {
+
+HitVerdict compare_without_exact(const TriangleScene& scene, const Ray& ray, Query query, const Hit& a, const Hit& b,
+                                 bool& needs_exact) {
+  needs_exact = false;
+  Difference kind = Difference::None;
+  if (a.found() != b.found()) {
+    kind = Difference::HitMiss;
+  } else if (a.found() && query == Query::Closest) {
+    if (!same_t(ray, a.t, b.t))
+      kind = Difference::Distance;
+    else if (a.geomID != b.geomID || a.primID != b.primID)
+      kind = Difference::Primitive;
+    else if (normals_differ(a.Ng, b.Ng))
+      kind = Difference::Normal;
+    else if (std::fabs(a.u - b.u) > kBarycentric || std::fabs(a.v - b.v) > kBarycentric)
+      kind = Difference::Barycentrics;
+  }
+  if (kind == Difference::None) return {};
+  const bool same_prim = a.found() && b.found() && a.geomID == b.geomID && a.primID == b.primID;
+  if (same_prim && a.primID < scene.triangles.size()) {
+    // Same triangle, numbers apart: whose are right? Embree's float t, u, v drift on
+    // thin triangles seen edge-on, and its float normal on needles; kmbvh's are refined
+    // in double precision.
+    double t, uv[2];
+    meet(scene, a.primID, ray, t, uv);
+    if (same_t(ray, a.t, t) && std::fabs(a.u - uv[0]) <= kBarycentric && std::fabs(a.v - uv[1]) <= kBarycentric &&
+        !normals_differ(a.Ng, exact_normal(scene, a.primID)))
+      return {HitVerdict::EmbreeImprecise, kind};
+  }
+  if (kind == Difference::Primitive && meets_at(scene, ray, a) && meets_at(scene, ray, b)) {
+    // Both found a triangle at the same distance (a shared edge or vertex, or coplanar
+    // overlapping faces): two independent systems agree on the distance, so either
+    // primitive is right, without a brute-force search for a nearer one.
+    return {HitVerdict::EdgeTie, kind};
+  }
+  const bool geometric = !same_prim && (kind == Difference::HitMiss || kind == Difference::Distance);
+  needs_exact = geometric && ray_is_valid(ray);
+  return {needs_exact ? HitVerdict::Agree : HitVerdict::Mismatch, kind};
+}
+
+HitVerdict decide_with_exact(const TriangleScene& scene, const Ray& ray, Query query, const Hit& a, const Hit& b,
+                             Difference kind, const ExactAnswers::Answer& g) {
+  const bool ours_right = acceptable(scene, ray, query, a, g);
+  if (ours_right && acceptable(scene, ray, query, b, g)) return {HitVerdict::EdgeTie, kind};
+  // Embree's float test answered what the exact one refutes: on a needle triangle (nearly
+  // collinear vertices), its plane is ill-conditioned and a ray that passes behind its
+  // origin can come out hitting it ahead.
+  if (ours_right) return {HitVerdict::EmbreeImprecise, kind};
+  return {HitVerdict::Mismatch, kind};
+}
+
+}  // namespace detail
+
+void count_verdict(HitComparison& c, const HitVerdict& v, size_t index, const Ray& ray, const Hit& ours,
+                   const Hit& reference, size_t keep) {
+  switch (v.outcome) {
+    case HitVerdict::Agree: return;
+    case HitVerdict::EdgeTie: ++c.edge_ties; return;
+    case HitVerdict::EmbreeImprecise: ++c.embree_imprecise; return;
+    case HitVerdict::Mismatch: break;
+  }
+  ++count_of(c, v.kind);
+  if (c.first.size() < keep) c.first.push_back(RayMismatch{index, to_string(v.kind), ray, ours, reference});
+}
+
 HitComparison compare_hits(const TriangleScene& scene, const std::vector<Ray>& rays, Query query,
                            const std::vector<Hit>& ours, const std::vector<Hit>& reference, size_t keep,
                            ExactAnswers* cache) {
@@ -156,68 +226,14 @@ HitComparison compare_hits(const TriangleScene& scene, const std::vector<Ray>& r
   out.rays = rays.size();
   for (size_t i = 0; i < rays.size(); ++i) {
     const Ray& ray = rays[i];
-    const Hit& a = ours[i];
-    const Hit& b = reference[i];
-    out.hits += b.found();
+    out.hits += reference[i].found();
     if (!ray_is_valid(ray)) ++out.skipped;
-    Difference kind = Difference::None;
-    if (a.found() != b.found()) {
-      kind = Difference::HitMiss;
-    } else if (a.found() && query == Query::Closest) {
-      if (!same_t(ray, a.t, b.t))
-        kind = Difference::Distance;
-      else if (a.geomID != b.geomID || a.primID != b.primID)
-        kind = Difference::Primitive;
-      else if (normals_differ(a.Ng, b.Ng))
-        kind = Difference::Normal;
-      else if (std::fabs(a.u - b.u) > kBarycentric || std::fabs(a.v - b.v) > kBarycentric)
-        kind = Difference::Barycentrics;
-    }
-    if (kind == Difference::None) continue;
-    const bool same_prim = a.found() && b.found() && a.geomID == b.geomID && a.primID == b.primID;
-    if (same_prim && a.primID < scene.triangles.size()) {
-      // Same triangle, numbers apart: whose are right? Embree's float t, u, v drift on
-      // thin triangles seen edge-on, and its float normal on needles; kmbvh's are refined
-      // in double precision.
-      double t, uv[2];
-      meet(scene, a.primID, ray, t, uv);
-      if (same_t(ray, a.t, t) && std::fabs(a.u - uv[0]) <= kBarycentric && std::fabs(a.v - uv[1]) <= kBarycentric &&
-          !normals_differ(a.Ng, exact_normal(scene, a.primID))) {
-        ++out.embree_imprecise;
-        continue;
-      }
-    }
-    if (kind == Difference::Primitive && meets_at(scene, ray, a) && meets_at(scene, ray, b)) {
-      // Both found a triangle at the same distance (a shared edge or vertex, or coplanar
-      // overlapping faces): two independent systems agree on the distance, so either
-      // primitive is right, without a brute-force search for a nearer one.
-      ++out.edge_ties;
-      continue;
-    }
-    const bool geometric = !same_prim && (kind == Difference::HitMiss || kind == Difference::Distance);
-    if (geometric && ray_is_valid(ray)) {
-      Ground g;
-      if (!cache) {
-        g = brute_force(scene, ray);
-      } else {
-        const auto found = cache->by_ray.find(i);
-        g = found != cache->by_ray.end() ? found->second : (cache->by_ray[i] = brute_force(scene, ray));
-      }
-      const bool ours_right = acceptable(scene, ray, query, a, g);
-      if (ours_right && acceptable(scene, ray, query, b, g)) {
-        ++out.edge_ties;
-        continue;
-      }
-      if (ours_right) {
-        // Embree's float test answered what the exact one refutes: on a needle triangle
-        // (nearly collinear vertices), its plane is ill-conditioned and a ray that passes
-        // behind its origin can come out hitting it ahead.
-        ++out.embree_imprecise;
-        continue;
-      }
-    }
-    ++count_of(out, kind);
-    if (out.first.size() < keep) out.first.push_back(RayMismatch{i, to_string(kind), ray, a, b});
+    const HitVerdict v = compare_hit(scene, ray, query, ours[i], reference[i], [&] {
+      if (!cache) return brute_force(scene, ray, true);
+      const auto found = cache->by_ray.find(i);
+      return found != cache->by_ray.end() ? found->second : (cache->by_ray[i] = brute_force(scene, ray, true));
+    });
+    count_verdict(out, v, i, ray, ours[i], reference[i], keep);
   }
   return out;
 }

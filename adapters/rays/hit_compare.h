@@ -57,9 +57,49 @@ struct ExactAnswers {
   std::unordered_map<size_t, Answer> by_ray;
 };
 
+// One ray's two answers under the rules above: agreeing (kind None), a difference both
+// answers explain (an edge tie, Embree's imprecision) or a mismatch of `kind`.
+struct HitVerdict {
+  enum Outcome { Agree, EdgeTie, EmbreeImprecise, Mismatch };
+  Outcome outcome = Agree;
+  Difference kind = Difference::None;
+};
+
+// The exact answer for one ray: a double-precision search over every triangle (over
+// OpenMP threads when `parallel` and the scene is large; the preload library's callers,
+// application threads, search alone).
+ExactAnswers::Answer exact_answer(const TriangleScene& scene, const Ray& ray, bool parallel = true);
+
+// `exact` is asked for the ray's exact answer only where the verdict needs it (a hit or a
+// distance on different triangles), so most rays cost no search.
+template <typename Exact>
+HitVerdict compare_hit(const TriangleScene& scene, const Ray& ray, Query query, const Hit& ours, const Hit& reference,
+                       Exact&& exact);
+
+// Adds one verdict to the counts (and the ray to `first` while it holds fewer than `keep`).
+void count_verdict(HitComparison& counts, const HitVerdict& verdict, size_t index, const Ray& ray, const Hit& ours,
+                   const Hit& reference, size_t keep);
+
 // For Query::Any only whether a hit was found is compared (Embree does not say which).
 HitComparison compare_hits(const TriangleScene& scene, const std::vector<Ray>& rays, Query query,
                            const std::vector<Hit>& ours, const std::vector<Hit>& reference, size_t keep = 5,
                            ExactAnswers* cache = nullptr);
+
+namespace detail {
+// compare_hit without the exact answer (the verdict, or Outcome::Agree with a kind whose
+// decision needs the exact answer: `needs_exact`), and the decision once it is known.
+HitVerdict compare_without_exact(const TriangleScene& scene, const Ray& ray, Query query, const Hit& ours,
+                                 const Hit& reference, bool& needs_exact);
+HitVerdict decide_with_exact(const TriangleScene& scene, const Ray& ray, Query query, const Hit& ours,
+                             const Hit& reference, Difference kind, const ExactAnswers::Answer& exact);
+}  // namespace detail
+
+template <typename Exact>
+HitVerdict compare_hit(const TriangleScene& scene, const Ray& ray, Query query, const Hit& ours, const Hit& reference,
+                       Exact&& exact) {
+  bool needs_exact = false;
+  const HitVerdict v = detail::compare_without_exact(scene, ray, query, ours, reference, needs_exact);
+  return needs_exact ? detail::decide_with_exact(scene, ray, query, ours, reference, v.kind, exact()) : v;
+}
 
 }  // namespace kmbvh

@@ -102,6 +102,7 @@ struct TraceCommand {
   uint32_t ray_seed = 7;
   bool compare_embree = false;
   size_t show = 5;               // mismatching rays printed in full
+  std::string replay;            // an A/B report of the preload library: its rays instead (replay.cpp)
 };
 
 // kmbvh stress [CASES...]: every builder on the generated stress cases.
@@ -138,5 +139,10 @@ int run_stress(const StressCommand& command);
 int run_trace(const TraceCommand& command);
 int run_render(const RenderCommand& command);
 int run_bench_paper(const BenchCommand& command);  // bench --suite paper (paper_suite_command.cpp)
+
+struct LoadedScene;
+// trace --replay (replay.cpp): the report's recorded rays through kmbvh's layouts of `bvh`
+// and through Embree, on the scene loaded for the command.
+int replay_recorded_rays(const TraceCommand& command, const LoadedScene& scene, const Bvh& bvh);
 
 }  // namespace kmbvh

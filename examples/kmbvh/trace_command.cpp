@@ -146,6 +146,10 @@ void add_trace_command(CLI::App& app, TraceCommand& c) {
   cmd->add_option("--ray-seed", c.ray_seed, "seed of the rays' random draws");
   cmd->add_flag("--compare-embree", c.compare_embree, "trace the same rays with Embree and count every difference");
   cmd->add_option("--show", c.show, "mismatching rays printed in full");
+  cmd->add_option("--replay", c.replay,
+                  "trace the mismatching rays an A/B report of the preload library recorded (KMBVH_AB_REPORT), on the "
+                  "scene it saved beside them, with kmbvh and Embree")
+      ->check(CLI::ExistingFile);
   add_run_options(*cmd, c.run);
 }
 
@@ -163,6 +167,10 @@ int run_trace(const TraceCommand& c) {
   progress.update(fmt::format("building with {}", config.label()));
   prepare_builder(config);
   const Bvh bvh = run_builder(config, scene.prims);
+  if (!c.replay.empty()) {
+    progress.done();
+    return replay_recorded_rays(c, scene, bvh);
+  }
 
   progress.update("making rays");
   const RaySets rays = scene_ray_sets(scene.geometry, scene.prims, c.count, c.ray_seed);

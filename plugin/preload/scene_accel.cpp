@@ -17,6 +17,7 @@ struct Offer {
   const RTCRay* app_ray;
   RTCIntersectContext* context;
   Query query;
+  FilterProbe* probe;
 };
 
 }  // namespace
@@ -27,6 +28,10 @@ bool SceneAccel::offer(void* user, const Ray&, const Hit& offered) {
   const GeometryFilters& f = (*o.filters)[offered.geomID];
   const RTCFilterFunctionN filter = o.query == Query::Any ? f.occluded : f.intersect;
   if (!filter) return true;
+  if (o.probe) {
+    ++o.probe->offers;
+    if (!o.probe->call_application) return false;
+  }
   RTCRay ray = *o.app_ray;  // Embree shows the filter the ray ending at the hit
   ray.tfar = offered.t;
   RTCHit hit;
@@ -47,9 +52,9 @@ bool SceneAccel::offer(void* user, const Ray&, const Hit& offered) {
 }
 
 bool SceneAccel::trace_filtered(const Ray& ray, const RTCRay& app_ray, unsigned ray_mask, Query query,
-                                RTCIntersectContext* context, Hit& hit) const {
+                                RTCIntersectContext* context, Hit& hit, FilterProbe* probe) const {
   if (ray_mask == 0 || !tracer_) return false;
-  Offer offer_data{&filters_, &app_ray, context, query};
+  Offer offer_data{&filters_, &app_ray, context, query, probe};
   return tracer_->trace_one(ray, query, hit, HitFilter{&SceneAccel::offer, &offer_data});
 }
 
@@ -69,13 +74,29 @@ SceneAccel::SceneAccel(const std::vector<EmbreeTriangleMesh>& meshes, std::vecto
   report.dropped = flat.dropped;
   report.triangles = flat.scene.triangles.size();
   report.isa = to_string(traversal_isa());  // a KMBVH_ISA this CPU cannot run fails here, before the build
-  if (flat.scene.triangles.empty()) return;  // every ray misses
+  if (flat.scene.triangles.empty()) {  // every ray misses
+    report_ = report;
+    if (plugin_config().ab.on) geometry_ = std::make_unique<AccelGeometry>(std::move(flat));
+    return;
+  }
   const PrimitiveSet prims = make_primitive_set(flat.scene);
   const Bvh bvh = run_builder(config, prims);
   report.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
   report.sah = sah_cost(bvh);
   tracer_ = std::make_unique<Tracer>(bvh, prims, flat.scene, Layout::Bvh8, Backend::Cpu, &flat.ids);
   report.layout_ms = tracer_->layout_ms();
+  report_ = report;
+  if (plugin_config().ab.on) geometry_ = std::make_unique<AccelGeometry>(std::move(flat));
+}
+
+AccelGeometry::AccelGeometry(FlattenedMeshes flat) : scene(std::move(flat.scene)), ids(std::move(flat.ids)) {
+  for (uint32_t t = 0; t < ids.size(); ++t) {
+    const PrimitiveId id = ids[t];
+    if (id.geom >= flat_of.size()) flat_of.resize(id.geom + 1);
+    std::vector<uint32_t>& of_geom = flat_of[id.geom];
+    if (id.prim >= of_geom.size()) of_geom.resize(id.prim + 1, kNoTriangle);
+    of_geom[id.prim] = t;
+  }
 }
 
 SceneAccel::~SceneAccel() = default;

@@ -30,6 +30,29 @@ struct GeometryFilters {
   RTCGeometry geometry = nullptr;  // its user data is read at each call, as Embree does
 };
 
+// What a filtered trace offered to the application's filter functions (the A/B mode's
+// probe, ab_mode.h): with call_application false, a candidate that would be offered is
+// refused and counted instead, so the application's function is not called.
+struct FilterProbe {
+  bool call_application = true;
+  unsigned offers = 0;  // candidates on a geometry with a filter for the query
+};
+
+// The scene's triangles as kmbvh built them, kept under KMBVH_AB for the oracle's exact
+// answers (adapters/rays/hit_compare.h): triangle t of `scene` is Embree's `ids[t]`.
+struct AccelGeometry {
+  TriangleScene scene;
+  std::vector<PrimitiveId> ids;
+  std::vector<std::vector<uint32_t>> flat_of;  // [geomID][primID]: t, or kNoTriangle
+  static constexpr uint32_t kNoTriangle = 0xFFFFFFFEu;
+
+  explicit AccelGeometry(FlattenedMeshes flat);
+  // The position in `scene` of Embree's (geomID, primID); kNoTriangle for none.
+  uint32_t triangle_of(uint32_t geom_id, uint32_t prim_id) const {
+    return geom_id < flat_of.size() && prim_id < flat_of[geom_id].size() ? flat_of[geom_id][prim_id] : kNoTriangle;
+  }
+};
+
 class SceneAccel {
  public:
   // filters: by geomID (empty: none). Throws (std::exception) when the meshes cannot be
@@ -46,7 +69,7 @@ class SceneAccel {
   // with a filter for this query is offered to it (app_ray: the application's ray, copied
   // for the call) and skipped when refused.
   bool trace_filtered(const Ray& ray, const RTCRay& app_ray, unsigned ray_mask, Query query,
-                      RTCIntersectContext* context, Hit& hit) const;
+                      RTCIntersectContext* context, Hit& hit, FilterProbe* probe = nullptr) const;
 
   // The closest hit within (tnear, tfar] of a ray Embree would also test: every geometry
   // of the scene has the default mask, so a ray of mask 0 misses (Debian's Embree is built
@@ -56,10 +79,17 @@ class SceneAccel {
     return tracer_->trace_one(ray, query, hit);
   }
 
+
+  const AccelReport& report() const { return report_; }
+  // The triangles, under KMBVH_AB only (null otherwise).
+  const AccelGeometry* geometry() const { return geometry_.get(); }
+
  private:
   static bool offer(void* user, const Ray& ray, const Hit& offered);
 
+  AccelReport report_;
   std::unique_ptr<Tracer> tracer_;  // null: nothing to hit
+  std::unique_ptr<AccelGeometry> geometry_;
   std::vector<GeometryFilters> filters_;
   bool intersect_filters_ = false, occluded_filters_ = false;
 };

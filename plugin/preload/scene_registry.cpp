@@ -12,6 +12,7 @@
 
 #include "plugin/plugin_config.h"
 #include "plugin/real_embree.h"
+#include "ab_report.h"
 #include "ray_counters.h"
 
 namespace kmbvh::plugin {
@@ -208,6 +209,7 @@ void commit_by_embree(RTCScene scene, SceneRecord& s, bool join, const std::stri
       log_line(fmt::format("scene {}: Embree answers it: {}", static_cast<void*>(scene), reason));
     s.last_fallback = reason;
   }
+  if (ab_mode_on()) ab_note_fallback(scene, reason);
   for (RTCScene child : instanced) ensure_embree_committed(child);
   real_commit(scene, join);
   s.embree_current.store(true, std::memory_order_release);
@@ -398,6 +400,7 @@ void commit_scene(RTCScene scene, bool join) {
 void commit_or_build(RTCScene scene, bool join) {
   if (!scene_path_enabled()) return real_commit(scene, join);
   report_rays_at_exit();
+  if (ab_mode_on()) report_ab_at_exit();
   SceneRecord* s = nullptr;
   std::vector<EmbreeTriangleMesh> meshes;
   std::vector<GeometryFilters> filters;
@@ -458,6 +461,7 @@ void commit_or_build(RTCScene scene, bool join) {
     s->last_fallback.clear();
     s->built_from = std::move(signature);
   }
+  if (ab_mode_on()) ab_note_kmbvh_scene(scene, report);
   if (embree_too) {
     real_commit(scene, join);
     s->embree_current.store(true, std::memory_order_release);

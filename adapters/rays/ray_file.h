@@ -1,0 +1,35 @@
+// Rays recorded by the preload library's A/B mode (KMBVH_AB_REPORT, plugin/README.md):
+// every mismatching ray of the report, in full, with the query it was and the two answers
+// it got, so that `kmbvh trace SCENE --replay REPORT` can trace it again on the scene the
+// report saved beside it (a regression case made from an application's own ray).
+#pragma once
+
+#include <stdexcept>
+#include <string>
+#include <vector>
+
+#include "cuda/traversal/ray.h"
+
+namespace kmbvh {
+
+struct RecordedRay {
+  Ray ray;
+  Query query = Query::Closest;
+  std::string kind;     // the mismatch it was reported as ("distance", ...)
+  std::string form;     // the application's query function ("rtcIntersect1", ...)
+  std::string scene;    // the scene entry of the report it came from
+  // The answers in the report; a closest hit names its triangle's position in the saved
+  // scene (primID), geomID 0.
+  Hit kmbvh, embree;
+};
+
+class RayFileError : public std::runtime_error {
+ public:
+  using std::runtime_error::runtime_error;
+};
+
+// Every first_mismatches ray of every scene and form of the report. Throws RayFileError
+// naming the file and what is wrong with it.
+std::vector<RecordedRay> read_recorded_rays(const std::string& path);
+
+}  // namespace kmbvh
