@@ -25,6 +25,9 @@ struct EmbreeAnswer {
 
 EmbreeAnswer embree_answer(RTCScene scene, const RayRef& r, Query query, RTCIntersectContext* context) {
   EmbreeAnswer a;
+  // A ray Embree aborts on (NaN, infinite, negative tnear: docs/design.md §7) is never sent
+  // to it; kmbvh answers such rays with a miss, and so does this.
+  if (!ray_is_valid(kmbvh_ray(r))) return a;
   if (query == Query::Any) {
     RTCRay ray = app_ray(r);
     KMBVH_REAL_EMBREE(rtcOccluded1)(scene, context, &ray);
@@ -97,6 +100,7 @@ void record(RTCScene scene, QueryForm form, const AccelGeometry& geometry, const
       ++c.unverified;
     }
     ++c.sampled, ++c.diff.rays;
+    c.diff.skipped += !ray_is_valid(ray);
     c.diff.hits += theirs.found();
     c.kmbvh_ns += kmbvh_ns, c.embree_ns += embree_ns;
     const size_t kept = c.diff.first.size();

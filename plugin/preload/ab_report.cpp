@@ -81,6 +81,7 @@ json form_json(QueryForm form, const FormCounts& c) {
             {"embree_only", c.embree_only},
             {"context_filter", c.context_filter},
             {"hits", d.hits},
+            {"not_sent_to_embree", d.skipped},
             {"mismatches", d.mismatches()},
             {"hit_miss", d.hit_miss},
             {"distance", d.distance},
