@@ -12,8 +12,12 @@ namespace {
 
 using Clock = std::chrono::steady_clock;
 
-double ns_between(Clock::time_point a, Clock::time_point b) {
-  return std::chrono::duration<double, std::nano>(b - a).count();
+// The wall time of one call, in nanoseconds.
+template <typename F>
+double ns_of(F&& f) {
+  const auto start = Clock::now();
+  f();
+  return std::chrono::duration<double, std::nano>(Clock::now() - start).count();
 }
 
 // Embree's answer to the ray as a Hit (found() for an occluded ray), and what Embree wrote
@@ -142,13 +146,8 @@ void ab_answer(const SceneAccel& accel, RTCScene scene, const RayRef& r, Query q
                QueryForm form) {
   const AbConfig& ab = plugin_config().ab;
   const AccelGeometry* geometry = accel.geometry();
-  const unsigned inst_id = context_inst_id(context);
   if (!geometry || !sampled_now(ab.sample)) {
-    if (!ab.embree_answers) {
-      Hit hit;
-      if (kmbvh_answer(accel, r, query, context, hit)) write_answer(r, query, hit, inst_id);
-      return;
-    }
+    if (!ab.embree_answers) return answer_with_kmbvh(accel, r, query, context);
     ensure_embree_committed(scene);
     const EmbreeAnswer e = embree_answer(scene, r, query, context);
     return write_answer(r, query, e.hit, e.instance);
@@ -158,50 +157,44 @@ void ab_answer(const SceneAccel& accel, RTCScene scene, const RayRef& r, Query q
   const Ray ray = kmbvh_ray(r);
   Hit ours;
   EmbreeAnswer theirs;
+  FilterProbe probe;
+  probe.call_application = false;
+  const bool filtered = accel.has_filters(query);
+  const auto trace_ours = [&] { kmbvh_answer(accel, r, query, context, ours, filtered ? &probe : nullptr); };
+  const auto trace_theirs = [&] { theirs = embree_answer(scene, r, query, context); };
   double kmbvh_ns = 0, embree_ns = 0;
   // The order alternates, so that neither system always finds the ray's memory warm.
   thread_local bool embree_first = false;
   embree_first = !embree_first;
-  if (accel.has_filters(query)) {
+  if (filtered) {
     // Where kmbvh answers, Embree must not trace the query at all: its traversal may offer
     // the application's filter a candidate kmbvh's never reached, and the filter's side
     // effects would then come from a query the application did not receive.
     if (!ab.embree_answers) {
-      if (kmbvh_answer(accel, r, query, context, ours)) write_answer(r, query, ours, inst_id);
+      answer_with_kmbvh(accel, r, query, context);
       return count_filtered(scene, form);
     }
-    // Where Embree answers, kmbvh probes without calling the filters: a query whose
-    // traversal reaches no filtered candidate has the same answer whatever they decide.
-    FilterProbe probe;
-    probe.call_application = false;
-    const auto t0 = Clock::now();
-    kmbvh_answer(accel, r, query, context, ours, &probe);
-    kmbvh_ns = ns_between(t0, Clock::now());
-    const auto t1 = Clock::now();
-    theirs = embree_answer(scene, r, query, context);
-    embree_ns = ns_between(t1, Clock::now());
+    // Where Embree answers, kmbvh probes without calling the filters (kmbvh first: the
+    // probe decides): a query whose traversal reaches no filtered candidate has the same
+    // answer whatever they decide.
+    kmbvh_ns = ns_of(trace_ours);
+    embree_ns = ns_of(trace_theirs);
     if (probe.offers > 0) {
       write_answer(r, query, theirs.hit, theirs.instance);
       return count_filtered(scene, form);
     }
   } else if (embree_first) {
-    const auto t0 = Clock::now();
-    theirs = embree_answer(scene, r, query, context);
-    const auto t1 = Clock::now();
-    kmbvh_answer(accel, r, query, context, ours);
-    embree_ns = ns_between(t0, t1), kmbvh_ns = ns_between(t1, Clock::now());
+    embree_ns = ns_of(trace_theirs);
+    kmbvh_ns = ns_of(trace_ours);
   } else {
-    const auto t0 = Clock::now();
-    kmbvh_answer(accel, r, query, context, ours);
-    const auto t1 = Clock::now();
-    theirs = embree_answer(scene, r, query, context);
-    kmbvh_ns = ns_between(t0, t1), embree_ns = ns_between(t1, Clock::now());
+    kmbvh_ns = ns_of(trace_ours);
+    embree_ns = ns_of(trace_theirs);
   }
   perturb(ours, query, ab.perturb);
   if (ab.embree_answers)
     write_answer(r, query, theirs.hit, theirs.instance);
   else
-    write_answer(r, query, ours, inst_id);
+    write_answer(r, query, ours, context_inst_id(context));
   try {
     record(scene, form, *geometry, ray, query, ours, theirs.hit, kmbvh_ns, embree_ns);
   } catch (...) {  // out of memory for the counts: this comparison goes uncounted

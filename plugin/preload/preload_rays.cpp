@@ -35,8 +35,7 @@ const SceneAccel* accel_for(RTCScene scene, const RTCIntersectContext* context) 
 inline void answer(const SceneAccel& accel, RTCScene scene, const RayRef& r, Query query, RTCIntersectContext* context,
                    QueryForm form) {
   if (ab_mode_on()) return ab_answer(accel, scene, r, query, context, form);
-  Hit hit;
-  if (kmbvh_answer(accel, r, query, context, hit)) write_answer(r, query, hit, context_inst_id(context));
+  answer_with_kmbvh(accel, r, query, context);
 }
 
 // A query Embree answers: counted, and under KMBVH_AB reported for its scene and form.

@@ -107,4 +107,10 @@ inline void write_answer(const RayRef& r, Query query, const Hit& hit, unsigned 
   *r.primID = hit.primID, *r.geomID = hit.geomID, *r.instID = inst_id;
 }
 
+// kmbvh's answer to the ray written to it: the scene path without the A/B mode.
+inline void answer_with_kmbvh(const SceneAccel& accel, const RayRef& r, Query query, RTCIntersectContext* context) {
+  Hit hit;
+  if (kmbvh_answer(accel, r, query, context, hit)) write_answer(r, query, hit, context_inst_id(context));
+}
+
 }  // namespace kmbvh::plugin

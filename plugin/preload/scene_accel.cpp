@@ -74,18 +74,14 @@ SceneAccel::SceneAccel(const std::vector<EmbreeTriangleMesh>& meshes, std::vecto
   report.dropped = flat.dropped;
   report.triangles = flat.scene.triangles.size();
   report.isa = to_string(traversal_isa());  // a KMBVH_ISA this CPU cannot run fails here, before the build
-  if (flat.scene.triangles.empty()) {  // every ray misses
-    report_ = report;
-    if (plugin_config().ab.on) geometry_ = std::make_unique<AccelGeometry>(std::move(flat));
-    return;
+  if (!flat.scene.triangles.empty()) {  // else every ray misses
+    const PrimitiveSet prims = make_primitive_set(flat.scene);
+    const Bvh bvh = run_builder(config, prims);
+    report.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    report.sah = sah_cost(bvh);
+    tracer_ = std::make_unique<Tracer>(bvh, prims, flat.scene, Layout::Bvh8, Backend::Cpu, &flat.ids);
+    report.layout_ms = tracer_->layout_ms();
   }
-  const PrimitiveSet prims = make_primitive_set(flat.scene);
-  const Bvh bvh = run_builder(config, prims);
-  report.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-  report.sah = sah_cost(bvh);
-  tracer_ = std::make_unique<Tracer>(bvh, prims, flat.scene, Layout::Bvh8, Backend::Cpu, &flat.ids);
-  report.layout_ms = tracer_->layout_ms();
-  report_ = report;
   if (plugin_config().ab.on) geometry_ = std::make_unique<AccelGeometry>(std::move(flat));
 }
 

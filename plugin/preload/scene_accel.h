@@ -80,14 +80,12 @@ class SceneAccel {
   }
 
 
-  const AccelReport& report() const { return report_; }
   // The triangles, under KMBVH_AB only (null otherwise).
   const AccelGeometry* geometry() const { return geometry_.get(); }
 
  private:
   static bool offer(void* user, const Ray& ray, const Hit& offered);
 
-  AccelReport report_;
   std::unique_ptr<Tracer> tracer_;  // null: nothing to hit
   std::unique_ptr<AccelGeometry> geometry_;
   std::vector<GeometryFilters> filters_;
