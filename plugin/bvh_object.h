@@ -64,6 +64,11 @@ class BvhObject {
   void set_emitting(bool emitting) { emitting_.store(emitting, std::memory_order_relaxed); }
   bool emitting() const { return emitting_.load(std::memory_order_relaxed); }
 
+  // Another BVH object kept for as long as this one (the preload library's A/B mode keeps
+  // Embree's own here, plugin/preload/ab_builder.h); its deleter releases it.
+  RTCBVH twin() const { return twin_.get(); }
+  void set_twin(std::shared_ptr<RTCBVHTy> twin) { twin_ = std::move(twin); }
+
  private:
   static constexpr unsigned kTag = 0x6b6d6268;  // "kmbh": tells kmbvh's objects from others
   unsigned tag_ = kTag;
@@ -74,6 +79,7 @@ class BvhObject {
   std::mutex blocks_mutex_;
   std::vector<std::unique_ptr<char[]>> blocks_;
   std::vector<std::unique_ptr<Arena>> arenas_;
+  std::shared_ptr<RTCBVHTy> twin_;
 };
 
 }  // namespace kmbvh::plugin

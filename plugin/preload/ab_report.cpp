@@ -32,7 +32,10 @@ struct Shared {
   std::vector<ThreadCounts*> threads;
   std::map<RTCScene, SceneNote> scenes;
   size_t saved = 0;
+  std::vector<BuildComparison> builds;  // the first kKeptBuilds
+  size_t more_builds = 0;               // compared but not kept
 };
+constexpr size_t kKeptBuilds = 1000;
 Shared& shared() {
   static Shared* all = new Shared;
   return *all;
@@ -128,9 +131,56 @@ std::string answer_text(const Hit& h, Query query) {
   return fmt::format("t {} geomID {} primID {}", h.t, h.geomID, h.primID);
 }
 
-std::string scene_name(RTCScene scene) { return fmt::format("{}", static_cast<void*>(scene)); }
-
 void report(const std::string& line) { log_line("A/B " + line); }
+
+const char* quality_name(RTCBuildQuality q) {
+  return q == RTC_BUILD_QUALITY_LOW ? "low" : q == RTC_BUILD_QUALITY_HIGH ? "high" : "medium";
+}
+
+json side_json(const BuildSide& b) {
+  json j = {{"built", b.built}, {"ms", b.ms}};
+  if (!b.tree) return j;
+  const TreeStats& t = *b.tree;
+  j["sah"] = t.sah_cost;
+  j["inner_nodes"] = t.inner_nodes;
+  j["leaves"] = t.leaves;
+  j["references"] = t.references;
+  j["mean_leaf"] = t.leaves ? double(t.references) / double(t.leaves) : 0.0;
+  j["max_leaf"] = t.max_leaf;
+  j["depth"] = t.depth;
+  return j;
+}
+
+std::string side_text(const BuildSide& b) {
+  if (!b.built) return "no tree";
+  if (!b.tree) return fmt::format("{:.1f} ms (its tree could not be followed through the callbacks)", b.ms);
+  const TreeStats& t = *b.tree;
+  return fmt::format("{:.1f} ms, SAH {:.2f}, {} nodes, {} leaves (mean {:.2f}, max {}), depth {}", b.ms, t.sah_cost,
+                     t.inner_nodes, t.leaves, t.leaves ? double(t.references) / double(t.leaves) : 0.0, t.max_leaf,
+                     t.depth);
+}
+
+// The builds, on stderr and as JSON.
+json builds_json(const Shared& all) {
+  json builds = json::array();
+  for (size_t i = 0; i < all.builds.size(); ++i) {
+    const BuildComparison& b = all.builds[i];
+    report(fmt::format("rtcBuildBVH {}: {} primitives, quality {}; the application received {}'s tree", i,
+                       b.primitives, quality_name(b.quality), b.embree_answered ? "Embree" : "kmbvh"));
+    report(fmt::format("  kmbvh ({}): {}", b.kmbvh_builder, side_text(b.kmbvh)));
+    report(fmt::format("  Embree: {}", side_text(b.embree)));
+    builds.push_back({{"primitives", b.primitives},
+                      {"quality", quality_name(b.quality)},
+                      {"answer", b.embree_answered ? "embree" : "kmbvh"},
+                      {"kmbvh_builder", b.kmbvh_builder},
+                      {"kmbvh", side_json(b.kmbvh)},
+                      {"embree", side_json(b.embree)}});
+  }
+  if (all.more_builds) report(fmt::format("{} more builds compared, not kept", all.more_builds));
+  return builds;
+}
+
+std::string scene_name(RTCScene scene) { return fmt::format("{}", static_cast<void*>(scene)); }
 
 void write_report() {
   try {
@@ -198,12 +248,15 @@ void write_report() {
       out_scenes.push_back(std::move(s));
     }
     report(fmt::format("total: {} queries compared, {} mismatches", compared, mismatches));
+    json builds = builds_json(all);
     if (ab.report.empty()) return;
     const json doc = {{"sample", ab.sample},
                       {"answer", ab.embree_answers ? "embree" : "kmbvh"},
                       {"compared", compared},
                       {"mismatches", mismatches},
-                      {"scenes", std::move(out_scenes)}};
+                      {"scenes", std::move(out_scenes)},
+                      {"builds", std::move(builds)},
+                      {"builds_not_kept", all.more_builds}};
     std::ofstream file(ab.report);
     file << doc.dump(2) << "\n";
     file.close();
@@ -285,6 +338,15 @@ void ab_note_fallback(RTCScene scene, const std::string& reason) {
     note.fallback = reason;
   } catch (...) {
   }
+}
+
+void ab_note_build(const BuildComparison& build) {
+  Shared& all = shared();
+  std::lock_guard<std::mutex> lock(all.mutex);
+  if (all.builds.size() < kKeptBuilds)
+    all.builds.push_back(build);
+  else
+    ++all.more_builds;
 }
 
 void report_ab_at_exit() {

@@ -18,6 +18,7 @@
 
 #include "ab_mode.h"
 #include "adapters/rays/hit_compare.h"
+#include "tree_capture.h"
 
 namespace kmbvh::plugin {
 
@@ -60,6 +61,21 @@ void update_counts(RTCScene scene, QueryForm form, Update&& update) {
 // The OBJ file the scene's triangles were saved to at its first mismatch (written now if
 // not yet, when KMBVH_AB_REPORT is set; empty otherwise or when it cannot be written).
 std::string saved_scene_file(RTCScene scene, const TriangleScene& triangles);
+
+// One rtcBuildBVH built by both systems (ab_builder.h).
+struct BuildSide {
+  bool built = false;  // a root came back
+  double ms = 0;       // the build with the application's callbacks (and the capture's bookkeeping)
+  std::optional<TreeStats> tree;  // nullopt: not built, or the callbacks could not be followed
+};
+struct BuildComparison {
+  size_t primitives = 0;
+  RTCBuildQuality quality = RTC_BUILD_QUALITY_MEDIUM;
+  std::string kmbvh_builder;  // "kmeans Q3"
+  bool embree_answered = false;
+  BuildSide kmbvh, embree;
+};
+void ab_note_build(const BuildComparison& build);
 
 // Registers the report at exit (once).
 void report_ab_at_exit();

@@ -1,6 +1,8 @@
 // Embree's five builder functions, for LD_PRELOAD: kmbvh's unless KMBVH_BUILDER=embree,
-// which passes every call to the real Embree. The choice is made once per process, so a
+// which passes every call to the real Embree; under KMBVH_AB both build (ab_builder.h). The choice is made once per process, so a
 // BVH object never crosses from one implementation to the other.
+#include "ab_builder.h"
+#include "ab_mode.h"
 #include "kmbvh/embree.h"
 #include "plugin_config.h"
 #include "real_embree.h"
@@ -16,12 +18,15 @@ KMBVH_EXPORT RTCBVH rtcNewBVH(RTCDevice device) {
 }
 
 KMBVH_EXPORT void* rtcBuildBVH(const RTCBuildArguments* args) {
-  return pass_through() ? KMBVH_REAL_EMBREE(rtcBuildBVH)(args) : kmbvhBuildBVH(args);
+  if (pass_through()) return KMBVH_REAL_EMBREE(rtcBuildBVH)(args);
+  return kmbvh::plugin::ab_mode_on() ? kmbvh::plugin::ab_build_bvh(args) : kmbvhBuildBVH(args);
 }
 
 KMBVH_EXPORT void* rtcThreadLocalAlloc(RTCThreadLocalAllocator allocator, size_t bytes, size_t align) {
-  return pass_through() ? KMBVH_REAL_EMBREE(rtcThreadLocalAlloc)(allocator, bytes, align)
-                        : kmbvhThreadLocalAlloc(allocator, bytes, align);
+  // Under KMBVH_AB, Embree builds too (ab_builder.h), and hands the callbacks its allocators.
+  const bool embree = pass_through() || (kmbvh::plugin::ab_mode_on() && kmbvh::plugin::embree_is_building());
+  return embree ? KMBVH_REAL_EMBREE(rtcThreadLocalAlloc)(allocator, bytes, align)
+                : kmbvhThreadLocalAlloc(allocator, bytes, align);
 }
 
 KMBVH_EXPORT void rtcRetainBVH(RTCBVH bvh) {

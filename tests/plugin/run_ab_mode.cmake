@@ -5,6 +5,9 @@
 #              recorded in full; `kmbvh trace SAVED_SCENE --replay REPORT` (REPLAY: the
 #              kmbvh binary) finds Embree's recorded answers again and no mismatch
 #   fallback   a scene Embree answers, reported with its reason and not compared
+#   builds     rtcBuildBVH built by both (the program: kmbvh_example_custom_bvh_embree, run
+#              with KMBVH_LOG=1): both trees measured; the tree the program counted itself is
+#              the answering system's, and kmbvh's measured tree is the one its build logged
 # With FILTER_CALLS=kmbvh|embree (scene_client --filter), the application's filter
 # functions must have run as often as they do when that system answers alone.
 #   -DPROGRAM=... "-DARGS=...;..." -DPRELOAD=... -DWORK=dir "-DENV=VAR=VALUE;..." -DEXPECT=...
@@ -81,6 +84,36 @@ message("A/B report: ${compared} compared, ${mismatches} mismatches (${hit_miss}
 if(EXPECT STREQUAL "zero")
   if(NOT mismatches EQUAL 0 OR compared LESS MIN_COMPARED)
     message(FATAL_ERROR "expected at least ${MIN_COMPARED} queries compared and no mismatch")
+  endif()
+elseif(EXPECT STREQUAL "builds")
+  string(JSON builds LENGTH "${json}" builds)
+  string(JSON answer GET "${json}" answer)
+  if(builds EQUAL 0)
+    message(FATAL_ERROR "no rtcBuildBVH in the report")
+  endif()
+  foreach(side kmbvh embree)
+    foreach(field inner_nodes leaves depth sah)
+      string(JSON ${side}_${field} GET "${json}" builds 0 ${side} ${field})
+    endforeach()
+  endforeach()
+  if(NOT out MATCHES ": ([0-9]+) nodes, ([0-9]+) leaves" OR NOT CMAKE_MATCH_1 EQUAL ${answer}_inner_nodes
+     OR NOT CMAKE_MATCH_2 EQUAL ${answer}_leaves)
+    message(FATAL_ERROR "the program counted another tree (${CMAKE_MATCH_1} nodes, ${CMAKE_MATCH_2} leaves) than "
+                        "${answer}'s (${${answer}_inner_nodes} nodes, ${${answer}_leaves} leaves)")
+  endif()
+  if(NOT log MATCHES "rtcBuildBVH: [^\n]*, SAH ([0-9.]+), ([0-9]+) nodes, ([0-9]+) leaves, depth ([0-9]+)")
+    message(FATAL_ERROR "no KMBVH_LOG line of kmbvh's build")
+  endif()
+  set(logged "${CMAKE_MATCH_1} ${CMAKE_MATCH_2} ${CMAKE_MATCH_3} ${CMAKE_MATCH_4}")
+  if(NOT log MATCHES "A/B   kmbvh \\([^)]*\\): [0-9.]+ ms, SAH ([0-9.]+), ([0-9]+) nodes, ([0-9]+) leaves \\([^)]*\\), depth ([0-9]+)")
+    message(FATAL_ERROR "no A/B line of kmbvh's build")
+  endif()
+  set(measured "${CMAKE_MATCH_1} ${CMAKE_MATCH_2} ${CMAKE_MATCH_3} ${CMAKE_MATCH_4}")
+  if(NOT logged STREQUAL measured)
+    message(FATAL_ERROR "kmbvh's tree as the A/B mode measured it (${measured}) is not the one it built (${logged})")
+  endif()
+  if(embree_leaves EQUAL 0 OR embree_inner_nodes EQUAL 0)
+    message(FATAL_ERROR "Embree's tree was not measured")
   endif()
 elseif(EXPECT STREQUAL "fallback")
   if(fallbacks EQUAL 0 OR NOT compared EQUAL 0 OR embree_only EQUAL 0 OR NOT log MATCHES "Embree answers it \\(")
