@@ -54,9 +54,14 @@ Built build_embree(TreeCapture& capture, RTCBuildPrimitive* prims, bool answerin
   const RTCBuildArguments a = capture.wrapped(twin, prims, answering);
   const auto start = Clock::now();
   Built b;
-  embree_building.store(true);
-  b.root = KMBVH_REAL_EMBREE(rtcBuildBVH)(&a);
-  embree_building.store(false);
+  struct Building {  // cleared however the build ends (an application's callback may throw through it)
+    Building() { embree_building.store(true); }
+    ~Building() { embree_building.store(false); }
+  };
+  {
+    const Building building;
+    b.root = KMBVH_REAL_EMBREE(rtcBuildBVH)(&a);
+  }
   b.ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
   if (b.root) b.stats = capture.stats(b.root);
   return b;

@@ -90,12 +90,11 @@ void record(RTCScene scene, QueryForm form, const AccelGeometry& geometry, const
   {
     ThreadCounts& mine = thread_counts();
     std::lock_guard<std::mutex> lock(mine.mutex);  // this thread's own: uncontended but for the exit report
-    FormCounts& c = mine.forms[{scene, form}];
-    uint32_t& searches = mine.exact_searches[scene];
+    FormCounts& c = mine.of(scene, form);
     bool needs_exact = false;
     verdict = detail::compare_without_exact(geometry.scene, ray, query, a, b, needs_exact);
-    if (needs_exact && searches < kExactSearches) {
-      ++searches, ++c.exact_searches;
+    if (needs_exact && mine.exact_searches[scene] < kExactSearches) {
+      ++mine.exact_searches[scene], ++c.exact_searches;
       // On this application thread alone: no OpenMP team inside a renderer's threads.
       verdict = detail::decide_with_exact(geometry.scene, ray, query, a, b, verdict.kind,
                                           exact_answer(geometry.scene, ray, false));

@@ -45,6 +45,19 @@ struct ThreadCounts {
   std::mutex mutex;
   std::map<std::pair<RTCScene, QueryForm>, FormCounts> forms;
   std::map<RTCScene, uint32_t> exact_searches;  // per scene, against ab_mode.cpp's budget
+
+  // The counts of a scene and form, under `mutex`. The last ones are kept at hand: a
+  // renderer asks one form of one scene, query after query (map entries never move).
+  FormCounts& of(RTCScene scene, QueryForm form) {
+    if (!last_ || scene != last_scene_ || form != last_form_)
+      last_ = &forms[{scene, form}], last_scene_ = scene, last_form_ = form;
+    return *last_;
+  }
+
+ private:
+  FormCounts* last_ = nullptr;
+  RTCScene last_scene_ = nullptr;
+  QueryForm last_form_ = QueryForm::Intersect1;
 };
 // Made on the thread's first compared query and kept to the end of the process (the report
 // may run while application threads still trace). Throws std::bad_alloc.
@@ -55,7 +68,7 @@ template <typename Update>
 void update_counts(RTCScene scene, QueryForm form, Update&& update) {
   ThreadCounts& mine = thread_counts();
   std::lock_guard<std::mutex> lock(mine.mutex);
-  update(mine.forms[{scene, form}]);
+  update(mine.of(scene, form));
 }
 
 // The OBJ file the scene's triangles were saved to at its first mismatch (written now if
