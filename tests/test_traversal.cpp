@@ -4,14 +4,18 @@
 #include <gtest/gtest.h>
 
 #include <cmath>
+#include <cstring>
 #include <limits>
 #include <optional>
 
 #include "adapters/builder_registry.h"
 #include "adapters/embree/embree_scene.h"
 #include "adapters/out/collapse_wide.h"
+#include "adapters/out/leaf_triangles.h"
 #include "adapters/out/tracer.h"
+#include "adapters/out/wide_layout.h"
 #include "adapters/rays/hit_compare.h"
+#include "cuda/core/threads.h"
 #include "cuda/metrics/validate.h"
 #include "cuda/traversal/watertight.h"
 #include "support/builder_specs.h"
@@ -67,7 +71,7 @@ void expect_layouts_match_brute_force(const TriangleScene& scene, const std::vec
     const Bvh bvh = run_builder(config, prims);
     for (const Layout layout : layouts_for(bvh)) {
       const Tracer tracer(bvh, prims, scene, layout);
-      EXPECT_TRUE(validate(tracer.traced_tree(), prims, ValidationLimits{config.max_leaf_size, 64}).ok());
+      EXPECT_TRUE(validate(traced_tree(bvh, layout), prims, ValidationLimits{config.max_leaf_size, 64}).ok());
       std::vector<Hit> hits, any;
       tracer.trace(rays, Query::Closest, hits);
       const HitComparison c = compare_hits(scene, rays, Query::Closest, hits, closest);
@@ -285,6 +289,67 @@ TEST(Traversal, CollapseKeepsPrimitivesAndFillsNodes) {
   BuilderConfig kary = parse_builder("Q3");
   kary.kmeans.wide = true;
   EXPECT_THROW(collapse_to_width(run_builder(kary, prims), 8), std::invalid_argument);  // k = 16 does not fit 8 lanes
+}
+
+// The Tracer's one-pass layout (wide_layout.h) against the reference it replaces: the
+// collapsed tree laid out by make_wide_bvh, byte for byte, for binary and k-ary trees, a
+// tree of one leaf, multi-mesh ids, degenerate triangles, and any thread count.
+template <int W>
+void expect_same_layout(const WideBvh<W>& fast, const WideBvh<W>& reference, const std::string& what) {
+  ASSERT_EQ(fast.nodes.size(), reference.nodes.size()) << what;
+  ASSERT_EQ(fast.packs.size(), reference.packs.size()) << what;
+  EXPECT_EQ(fast.stack_size, reference.stack_size) << what;
+  EXPECT_EQ(std::memcmp(fast.nodes.data(), reference.nodes.data(), fast.nodes.size() * sizeof(WideNode<W>)), 0) << what;
+  EXPECT_EQ(std::memcmp(fast.packs.data(), reference.packs.data(), fast.packs.size() * sizeof(TrianglePack)), 0) << what;
+}
+
+template <int W>
+void expect_one_pass_layout_is_the_reference(const Bvh& bvh, const PrimitiveSet& prims, const TriangleScene& scene,
+                                             const std::vector<PrimitiveId>* reported_ids, const std::string& what) {
+  const bool collapse = tree_arity(bvh) <= 2;
+  const Bvh tree = collapse ? collapse_to_width(bvh, W) : bvh;
+  LeafTriangles triangles = leaf_triangles(tree, prims, scene);
+  if (reported_ids)
+    for (PrimitiveId& id : triangles.ids) id = (*reported_ids)[id.prim];
+  const WideBvh<W> reference = make_wide_bvh<W>(tree, std::move(triangles));
+  for (const int threads : {1, 2, 3}) {
+    set_thread_count(threads);
+    expect_same_layout(lay_out_wide<W>(bvh, prims, scene, collapse, reported_ids), reference,
+                       what + ", " + std::to_string(threads) + " threads");
+  }
+  set_thread_count(0);
+}
+
+TEST(Traversal, OnePassLayoutIsTheReferenceByteForByte) {
+  TriangleScene scene = test::random_triangles(4000, 36);
+  scene.triangles[10] = {scene.triangles[10][0], scene.triangles[10][0], scene.triangles[10][1]};  // degenerate
+  const PrimitiveSet prims = make_primitive_set(scene);
+  for (const char* spec : {"sweep-sah", "lbvh", "Q2", "embree-medium", "Q2+wide4", "Q2+wide8"}) {
+    const Bvh bvh = run_builder(test::config_from_spec(spec), prims);
+    if (tree_arity(bvh) <= 4) expect_one_pass_layout_is_the_reference<4>(bvh, prims, scene, nullptr, spec);
+    expect_one_pass_layout_is_the_reference<8>(bvh, prims, scene, nullptr, spec);
+  }
+  std::vector<PrimitiveId> ids(scene.triangles.size());
+  for (size_t t = 0; t < ids.size(); ++t) ids[t] = PrimitiveId{uint32_t(t % 3), uint32_t(t / 3)};
+  expect_one_pass_layout_is_the_reference<8>(run_builder(parse_builder("Q3"), prims), prims, scene, &ids, "reported ids");
+  const TriangleScene few = test::random_triangles(3, 37);
+  const PrimitiveSet few_prims = make_primitive_set(few);
+  expect_one_pass_layout_is_the_reference<8>(run_builder(parse_builder("Q2"), few_prims), few_prims, few, nullptr,
+                                             "one leaf");
+}
+
+TEST(Traversal, OnePassLayoutRefusesWhatDoesNotFit) {
+  const TriangleScene scene = test::random_triangles(1000, 38);
+  const PrimitiveSet prims = make_primitive_set(scene);
+  BuilderConfig kary = parse_builder("Q3");
+  kary.kmeans.wide = true;  // k = 16 children
+  EXPECT_THROW(lay_out_wide<8>(run_builder(kary, prims), prims, scene, false), std::invalid_argument);
+  Bvh bvh = run_builder(parse_builder("Q2"), prims);
+  bvh.prim_indices[5] = uint32_t(prims.size());  // a primitive the set does not have
+  EXPECT_THROW(lay_out_wide<8>(bvh, prims, scene, true), std::invalid_argument);
+  const std::vector<PrimitiveId> too_few(3);
+  EXPECT_THROW(lay_out_wide<8>(run_builder(parse_builder("Q2"), prims), prims, scene, true, &too_few),
+               std::invalid_argument);
 }
 
 TEST(Traversal, Bvh2NeedsABinaryTree) {

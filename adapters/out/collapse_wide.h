@@ -11,6 +11,12 @@
 
 namespace kmbvh {
 
+// The children node `node` of `bvh` has once opened greedily up to `width` (the step
+// collapse_to_width takes at every node): their indices into bvh.nodes, in lane order,
+// written to `children` (room for `width`); returns how many. `node` must be interior and
+// have at most `width` children.
+uint32_t open_children(const Bvh& bvh, uint32_t node, uint32_t width, uint32_t* children);
+
 // Returns a tree whose nodes have at most `width` children (2 <= width <= 64).
 // Throws std::invalid_argument if a node of `bvh` already has more.
 Bvh collapse_to_width(const Bvh& bvh, uint32_t width);

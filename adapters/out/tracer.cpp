@@ -8,6 +8,7 @@
 #include "cuda/traversal/traverse_bvh2.h"
 #include "trace_wide.h"
 #include "wide_bvh.h"
+#include "wide_layout.h"
 
 namespace kmbvh {
 
@@ -29,6 +30,10 @@ const char* to_string(Layout layout) {
 
 uint32_t layout_width(Layout layout) { return layout == Layout::Bvh2 ? 2 : layout == Layout::Bvh4 ? 4 : 8; }
 
+Bvh traced_tree(const Bvh& bvh, Layout layout) {
+  return layout != Layout::Bvh2 && tree_arity(bvh) <= 2 ? collapse_to_width(bvh, layout_width(layout)) : bvh;
+}
+
 Tracer::Tracer(const Bvh& bvh, const PrimitiveSet& prims, const TriangleScene& scene, Layout layout, Backend backend,
                const std::vector<PrimitiveId>* reported_ids)
     : layout_(layout), backend_(backend), layouts_(std::make_unique<Layouts>()) {
@@ -42,20 +47,19 @@ Tracer::Tracer(const Bvh& bvh, const PrimitiveSet& prims, const TriangleScene& s
     throw std::invalid_argument("a " + std::string(to_string(layout)) + " layout needs nodes of at most " +
                                 std::to_string(width) + " children; this tree has " + std::to_string(arity));
   collapsed_ = layout != Layout::Bvh2 && arity <= 2;
-  tree_ = collapsed_ ? collapse_to_width(bvh, width) : bvh;
-  LeafTriangles triangles = leaf_triangles(tree_, prims, scene);
-  if (reported_ids) {
-    if (reported_ids->size() != scene.triangles.size())
-      throw std::invalid_argument("Tracer: reported_ids needs one id per triangle of the scene");
-    for (PrimitiveId& id : triangles.ids) id = (*reported_ids)[id.prim];
-  }
+  if (reported_ids && reported_ids->size() != scene.triangles.size())
+    throw std::invalid_argument("Tracer: reported_ids needs one id per triangle of the scene");
   switch (layout) {
-    case Layout::Bvh2:
-      layouts_->bvh2 = make_bvh2(tree_, std::move(triangles));
+    case Layout::Bvh2: {
+      LeafTriangles triangles = leaf_triangles(bvh, prims, scene);
+      if (reported_ids)
+        for (PrimitiveId& id : triangles.ids) id = (*reported_ids)[id.prim];
+      layouts_->bvh2 = make_bvh2(bvh, std::move(triangles));
       if (backend == Backend::Cuda) layouts_->bvh2_gpu = std::make_unique<Bvh2OnGpu>(layouts_->bvh2);
       break;
-    case Layout::Bvh4: layouts_->bvh4 = make_wide_bvh<4>(tree_, std::move(triangles)); break;
-    case Layout::Bvh8: layouts_->bvh8 = make_wide_bvh<8>(tree_, std::move(triangles)); break;
+    }
+    case Layout::Bvh4: layouts_->bvh4 = lay_out_wide<4>(bvh, prims, scene, collapsed_, reported_ids); break;
+    case Layout::Bvh8: layouts_->bvh8 = lay_out_wide<8>(bvh, prims, scene, collapsed_, reported_ids); break;
   }
   layout_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }

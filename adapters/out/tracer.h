@@ -21,6 +21,11 @@ enum class Layout { Bvh2, Bvh4, Bvh8 };
 const char* to_string(Layout layout);
 uint32_t layout_width(Layout layout);
 
+// The tree a layout traces, as a Bvh: for the wide layouts a binary tree collapsed
+// (collapse_wide.h), otherwise `bvh` itself. The Tracer lays its layout out without making
+// it (wide_layout.h); this is for measuring it (its SAH) and checking it.
+Bvh traced_tree(const Bvh& bvh, Layout layout);
+
 class Tracer {
  public:
   // prims: the set `bvh` was built over, made from `scene`. A binary tree is collapsed for
@@ -53,8 +58,7 @@ class Tracer {
   bool trace_one(const Ray& ray, Query query, Hit& hit, const HitFilter& filter) const;
 
   Layout layout() const { return layout_; }
-  const Bvh& traced_tree() const { return tree_; }  // the tree as laid out (after any collapse)
-  bool collapsed() const { return collapsed_; }
+  bool collapsed() const { return collapsed_; }  // a binary tree collapsed for a wide layout
   double layout_ms() const { return layout_ms_; }
   size_t layout_bytes() const;
   uint32_t stack_size() const;
@@ -65,7 +69,6 @@ class Tracer {
   struct Layouts;
   Layout layout_;
   Backend backend_;
-  Bvh tree_;
   bool collapsed_ = false;
   double layout_ms_ = 0;
   std::unique_ptr<Layouts> layouts_;

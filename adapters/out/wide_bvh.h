@@ -16,6 +16,7 @@
 #include <vector>
 
 #include "cuda/core/bvh.h"
+#include "layout_memory.h"
 #include "leaf_triangles.h"
 
 namespace kmbvh {
@@ -41,8 +42,8 @@ static_assert(sizeof(TrianglePack) == 176, "a pack is meant to take what Embree'
 
 template <int W>
 struct WideBvh {
-  std::vector<WideNode<W>> nodes;  // nodes[0] is the root; empty for an empty scene
-  std::vector<TrianglePack> packs;
+  LayoutArray<WideNode<W>> nodes;  // nodes[0] is the root; empty for an empty scene
+  LayoutArray<TrianglePack> packs;
   uint32_t stack_size = 1;  // bounds the traversal stack: (W - 1) per level, plus one
 };
 

@@ -241,7 +241,7 @@ int run_trace(const TraceCommand& c) {
       }
       results.push_back(std::move(r));
     }
-    const double traced_sah = sah_cost(tracer.traced_tree());
+    const double traced_sah = sah_cost(traced_tree(bvh, layout));
     if (c.run.json) {
       Json kinds_json = Json::array();
       for (const KindResult& r : results) {

@@ -1,0 +1,160 @@
+#include "wide_layout.h"
+
+#include <algorithm>
+#include <cfloat>
+#include <limits>
+#include <stdexcept>
+#include <string>
+
+#include "collapse_wide.h"
+#include "cuda/core/parallel_errors.h"
+#include "cuda/traversal/watertight.h"
+
+namespace kmbvh {
+namespace {
+
+// A leaf of the source tree and the first of the packs it fills.
+struct LeafJob {
+  uint32_t node, first_pack;
+};
+
+// The plan: every node written (boxes, counts and links: all but the packs), and each
+// leaf's place among the packs, in the order make_wide_bvh packs them.
+template <int W>
+struct Plan {
+  WideBvh<W> out;
+  LayoutArray<LeafJob> leaves;
+  uint32_t packs = 0;
+};
+
+template <int W>
+WideNode<W> empty_node() {
+  WideNode<W> n;
+  for (int i = 0; i < W; ++i) {
+    for (int d = 0; d < 3; ++d) {
+      n.lo[d][i] = FLT_MAX;
+      n.hi[d][i] = -FLT_MAX;
+    }
+    n.ref[i] = 0;
+    n.count[i] = 1;  // as wide_bvh.cpp: never entered, and it would read as a leaf
+  }
+  return n;
+}
+
+// Lane `lane` of `node` for source node `c`; a leaf's packs are reserved in order.
+template <int W>
+void plan_lane(Plan<W>& plan, WideNode<W>& node, int lane, const Bvh& bvh, uint32_t c) {
+  const BvhNode& n = bvh.nodes[c];
+  if (n.is_leaf() && n.count == 0) return;  // the empty set's leaf: an empty lane
+  for (int d = 0; d < 3; ++d) {
+    node.lo[d][lane] = n.box.lo[d];
+    node.hi[d][lane] = n.box.hi[d];
+  }
+  node.count[lane] = n.is_leaf() ? n.count : 0;
+  node.ref[lane] = 0;  // an interior child's index is set when it is written
+  if (n.is_leaf()) {
+    node.ref[lane] = plan.packs;
+    plan.leaves.push_back(LeafJob{c, plan.packs});
+    plan.packs += (n.count + kPackWidth - 1) / kPackWidth;
+  }
+}
+
+// Depth first, first child first, as lay_out_depth_first walks the collapsed tree.
+template <int W>
+Plan<W> plan_layout(const Bvh& bvh, bool collapse) {
+  Plan<W> plan;
+  plan.out.nodes.reserve(bvh.nodes.size() / (collapse ? W - 1 : 1) + 1);
+  plan.leaves.reserve(bvh.nodes.size() / 2 + 1);
+  if (bvh.root().is_leaf()) {  // one leaf: a root with a single lane
+    plan.out.nodes.push_back(empty_node<W>());
+    plan_lane(plan, plan.out.nodes[0], 0, bvh, 0);
+    return plan;
+  }
+  struct Pending {
+    uint32_t node, parent, slot, depth;
+  };
+  std::vector<Pending> stack{{0, UINT32_MAX, 0, 1}};
+  uint32_t max_depth = 1;
+  uint32_t children[W];
+  while (!stack.empty()) {
+    const Pending p = stack.back();
+    stack.pop_back();
+    const BvhNode& n = bvh.nodes[p.node];
+    if (n.count > W)
+      throw std::invalid_argument("a " + std::to_string(W) + "-wide layout got a node of " + std::to_string(n.count) +
+                                  " children");
+    uint32_t count = n.count;
+    if (collapse) {
+      count = open_children(bvh, p.node, W, children);
+    } else {
+      for (uint32_t c = 0; c < count; ++c) children[c] = n.first + c;
+    }
+    const uint32_t index = uint32_t(plan.out.nodes.size());
+    plan.out.nodes.push_back(empty_node<W>());
+    for (uint32_t c = 0; c < count; ++c) plan_lane(plan, plan.out.nodes[index], int(c), bvh, children[c]);
+    if (p.parent != UINT32_MAX) plan.out.nodes[p.parent].ref[p.slot] = index;
+    max_depth = std::max(max_depth, p.depth);
+    for (uint32_t c = count; c-- > 0;)
+      if (!bvh.nodes[children[c]].is_leaf()) stack.push_back({children[c], index, c, p.depth + 1});
+  }
+  plan.out.stack_size = (W - 1) * max_depth + 1;
+  return plan;
+}
+
+// The packs of one leaf, gathered from the scene (leaf_triangles.cpp and wide_bvh.cpp's
+// pack_leaf in one step: degenerate triangles and unused slots as NaN, never hit).
+void fill_leaf(TrianglePack* packs, const BvhNode& leaf, const Bvh& bvh, const PrimitiveSet& prims,
+               const TriangleScene& scene, const std::vector<PrimitiveId>* reported_ids) {
+  const float nan = std::numeric_limits<float>::quiet_NaN();
+  for (uint32_t i = 0; i < leaf.count; i += kPackWidth) {
+    TrianglePack& pack = packs[i / kPackWidth];
+    for (uint32_t slot = 0; slot < uint32_t(kPackWidth); ++slot) {
+      Vec3 v[3] = {Vec3(nan), Vec3(nan), Vec3(nan)};
+      PrimitiveId id{kInvalidId, kInvalidId};
+      if (i + slot < leaf.count) {
+        const uint32_t j = bvh.prim_indices[leaf.first + i + slot];
+        if (j >= prims.size()) throw std::invalid_argument("lay_out_wide: a leaf names a primitive the set does not have");
+        id = prims.ids[j];
+        if (id.prim >= scene.triangles.size())
+          throw std::invalid_argument("lay_out_wide: a primitive is not in the scene");
+        const Triangle& t = scene.triangles[id.prim];
+        const Vec3 a = scene.positions[t[0]], b = scene.positions[t[1]], c = scene.positions[t[2]];
+        if (!is_degenerate_triangle(a, b, c)) v[0] = a, v[1] = b, v[2] = c;
+        if (reported_ids) id = (*reported_ids)[id.prim];
+      }
+      for (int k = 0; k < 3; ++k)
+        for (int axis = 0; axis < 3; ++axis) pack.v[k][axis][slot] = v[k][axis];
+      pack.id[slot] = id;
+    }
+  }
+}
+
+}  // namespace
+
+template <int W>
+WideBvh<W> lay_out_wide(const Bvh& bvh, const PrimitiveSet& prims, const TriangleScene& scene, bool collapse,
+                        const std::vector<PrimitiveId>* reported_ids) {
+  if (reported_ids && reported_ids->size() != scene.triangles.size())
+    throw std::invalid_argument("lay_out_wide: reported_ids needs one id per triangle of the scene");
+  if (bvh.empty() || (bvh.root().is_leaf() && bvh.root().count == 0)) return WideBvh<W>();
+  Plan<W> plan = plan_layout<W>(bvh, collapse);
+  WideBvh<W>& out = plan.out;
+  out.packs.resize(plan.packs);  // not zeroed (layout_memory.h): fill_leaf writes each pack whole
+  ParallelErrors errors;
+#pragma omp parallel for schedule(dynamic, 512)
+  for (size_t l = 0; l < plan.leaves.size(); ++l) {
+    errors.capture([&] {
+      const LeafJob job = plan.leaves[l];
+      fill_leaf(&out.packs[job.first_pack], bvh.nodes[job.node], bvh, prims, scene, reported_ids);
+    });
+  }
+  errors.rethrow();
+  return std::move(plan.out);
+}
+
+template WideBvh<4> lay_out_wide<4>(const Bvh&, const PrimitiveSet&, const TriangleScene&, bool,
+                                    const std::vector<PrimitiveId>*);
+template WideBvh<8> lay_out_wide<8>(const Bvh&, const PrimitiveSet&, const TriangleScene&, bool,
+                                    const std::vector<PrimitiveId>*);
+
+}  // namespace kmbvh

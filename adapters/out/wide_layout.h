@@ -1,0 +1,30 @@
+// Any builder's tree straight into a 4- or 8-wide traversal layout, in one pass: the
+// greedy collapse (collapse_wide.h), the depth-first node order (depth_first.h) and the
+// triangle packs (wide_bvh.h) without the collapsed Bvh and the leaf-ordered triangle
+// array in between. One sequential walk plans the nodes and where each leaf's packs go;
+// the packs, which gather the triangles from the scene and take most of the time, are then
+// filled by every thread. The layout is the same, byte for byte, as
+// make_wide_bvh(collapse_to_width(bvh, W), leaf_triangles(...)), the readable reference
+// the tests compare it with.
+#pragma once
+
+#include <vector>
+
+#include "adapters/triangles/triangle_scene.h"
+#include "cuda/core/bvh.h"
+#include "cuda/core/primitive_set.h"
+#include "wide_bvh.h"
+
+namespace kmbvh {
+
+// prims: the set `bvh` was built over, made from `scene`. collapse: open interior children
+// greedily up to W lanes (a binary tree); otherwise every node is laid out with the
+// children it has, at most W (a k-ary tree). reported_ids, when given, replaces each
+// triangle's id by reported_ids[id.prim] (Embree's ids of a flattened multi-mesh scene).
+// Throws std::invalid_argument for a node of more than W children or a primitive that is
+// not in the scene.
+template <int W>
+WideBvh<W> lay_out_wide(const Bvh& bvh, const PrimitiveSet& prims, const TriangleScene& scene, bool collapse,
+                        const std::vector<PrimitiveId>* reported_ids = nullptr);
+
+}  // namespace kmbvh
