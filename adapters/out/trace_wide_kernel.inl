@@ -174,15 +174,23 @@ struct PackRay {
 
 // The candidates of a pack's test, confirmed one by one in double precision (watertight.h:
 // exact_check): `hits`, the slots the vector test accepted, with their t; `redo`, those
-// whose edge functions came out exactly zero, for the scalar test.
-template <Query query, typename Count>
+// whose edge functions came out exactly zero, for the scalar test. Without `Refine` (an
+// unfiltered occlusion query, whose hit reports no t, u or v) only the interval is checked
+// (exact_within), and `check` says nothing more.
+template <Query query, bool Refine, typename Count>
 __attribute__((always_inline)) inline int confirm_hits(const TrianglePack& p, const PackRay& r, float tnear, float tmax,
                                                        vfp t, unsigned hits, unsigned redo, float& t_hit,
                                                        ExactCheck& check, Count& count) {
   auto vertex = [&](int v, int slot) { return Vec3(p.v[v][0][slot], p.v[v][1][slot], p.v[v][2][slot]); };
   auto exact = [&](int slot) {
     count.exact();
-    return exact_check(r.ray, vertex(0, slot), vertex(1, slot), vertex(2, slot), tnear, tmax);
+    if constexpr (Refine) {
+      return exact_check(r.ray, vertex(0, slot), vertex(1, slot), vertex(2, slot), tnear, tmax);
+    } else {
+      ExactCheck within;
+      within.within = exact_within(r.ray, vertex(0, slot), vertex(1, slot), vertex(2, slot), tnear, tmax);
+      return within;
+    }
   };
   int best = -1;
   for (; hits; hits &= hits - 1) {
@@ -210,11 +218,11 @@ __attribute__((always_inline)) inline int confirm_hits(const TrianglePack& p, co
 // Out of line for closest-hit queries: most packs have no candidate, and the vector test
 // keeps its registers; inline for occlusion, whose first confirmed hit ends the ray (the
 // faster of the two for each, measured).
-template <Query query, typename Count>
+template <Query query, bool Refine, typename Count>
 __attribute__((noinline)) int confirm_hits_apart(const TrianglePack& p, const PackRay& r, float tnear, float tmax,
                                                  vfp t, unsigned hits, unsigned redo, float& t_hit, ExactCheck& check,
                                                  Count& count) {
-  return confirm_hits<query>(p, r, tnear, tmax, t, hits, redo, t_hit, check, count);
+  return confirm_hits<query, Refine>(p, r, tnear, tmax, t, hits, redo, t_hit, check, count);
 }
 
 // The watertight test (cuda/traversal/watertight.h) on a pack of triangles at once, in the
@@ -223,7 +231,8 @@ __attribute__((noinline)) int confirm_hits_apart(const TrianglePack& p, const Pa
 // be hit, since any one will do. A slot whose edge functions come out exactly zero goes
 // to the scalar test, which redoes them in double precision.
 // `skip`: slots a hit filter has already turned down for this ray (0 without a filter).
-template <Query query, typename Count>
+// `Refine`: whether the hit will report its exact t, u and v (confirm_hits).
+template <Query query, bool Refine, typename Count>
 __attribute__((always_inline)) inline int intersect_pack(const TrianglePack& p, const PackRay& r, float tnear,
                                                          float tmax, float& t_hit, ExactCheck& check, Count& count,
                                                          unsigned skip = 0) {
@@ -252,9 +261,9 @@ __attribute__((always_inline)) inline int intersect_pack(const TrianglePack& p, 
   const unsigned redo = mask_bits(exact_zero) & ~skip;
   if (!(hits | redo)) return -1;
   if constexpr (query == Query::Any)
-    return confirm_hits<query>(p, r, tnear, tmax, T / det, hits, redo, t_hit, check, count);
+    return confirm_hits<query, Refine>(p, r, tnear, tmax, T / det, hits, redo, t_hit, check, count);
   else
-    return confirm_hits_apart<query>(p, r, tnear, tmax, T / det, hits, redo, t_hit, check, count);
+    return confirm_hits_apart<query, Refine>(p, r, tnear, tmax, T / det, hits, redo, t_hit, check, count);
 }
 
 // Completes the hit on triangle `found` (hit.t is set): its ids, and unless `refine` is
@@ -351,7 +360,8 @@ bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit,
       count.pack(std::min<uint32_t>(kPackWidth, cur.count - (p - cur.ref) * kPackWidth));
       if (!Filtered) {
         ExactCheck e;
-        const int slot = intersect_pack<query>(bvh.packs[p], pack_ray, ray.tnear, tmax, t, e, count);
+        const int slot =
+            intersect_pack<query, query == Query::Closest>(bvh.packs[p], pack_ray, ray.tnear, tmax, t, e, count);
         if (slot < 0) continue;
         found = p * kPackWidth + uint32_t(slot);
         check = e;
@@ -365,7 +375,7 @@ bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit,
       // the filter refuses is skipped and the next tried.
       for (unsigned skip = 0;;) {
         ExactCheck e;
-        const int slot = intersect_pack<query>(bvh.packs[p], pack_ray, ray.tnear, tmax, t, e, count, skip);
+        const int slot = intersect_pack<query, true>(bvh.packs[p], pack_ray, ray.tnear, tmax, t, e, count, skip);
         if (slot < 0) break;
         const uint32_t candidate = p * kPackWidth + uint32_t(slot);
         Hit offered;

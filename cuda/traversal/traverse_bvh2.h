@@ -70,8 +70,14 @@ KMBVH_HD KMBVH_INLINE bool trace_bvh2(const Bvh2View& view, const Ray& ray, Quer
         const LeafTriangle& tri = view.triangles[i];
         Hit candidate;
         if (!intersect_watertight(shear, ray.tnear, tmax, tri.a, tri.b, tri.c, candidate)) continue;
-        const ExactCheck exact = exact_check(ray, tri.a, tri.b, tri.c, ray.tnear, tmax);
-        if (!exact.within) continue;
+        // Occlusion reports no t, u or v: the cheaper check of the interval alone.
+        ExactCheck exact;
+        if (query == Query::Any) {
+          if (!exact_within(ray, tri.a, tri.b, tri.c, ray.tnear, tmax)) continue;
+        } else {
+          exact = exact_check(ray, tri.a, tri.b, tri.c, ray.tnear, tmax);
+          if (!exact.within) continue;
+        }
         found = i;
         check = exact;
         hit = candidate;
