@@ -172,33 +172,48 @@ struct PackRay {
   }
 };
 
-// The candidates of a pack's test, confirmed one by one in double precision (watertight.h:
-// exact_check): `hits`, the slots the vector test accepted, with their t; `redo`, those
-// whose edge functions came out exactly zero, for the scalar test. Without `Refine` (an
-// unfiltered occlusion query, whose hit reports no t, u or v) only the interval is checked
-// (exact_within), and `check` says nothing more.
-template <Query query, bool Refine, typename Count>
+// How a pack's candidate hits are confirmed in double precision (watertight.h), which
+// keeps a needle's float t from landing on the wrong side of tnear or tmax:
+// - Exact: each by exact_check before it counts, which also gives the t, u and v the hit
+//   reports (a filter is offered complete hits);
+// - Interval: each by exact_within, the interval alone (occlusion reports no t, u or v);
+// - Deferred: none while the ray runs; the closest hit's, once found, by exact_check over
+//   the interval it was accepted in (traverse), and in the rare case it fails there the ray
+//   is traced again with Exact. A closest-hit ray meets 1.1-1.3 candidates on average, so
+//   the ones later beaten are never measured; the answer is the same (see traverse).
+enum class Confirm { Exact, Interval, Deferred };
+
+// The candidates of a pack's test, confirmed one by one (Confirm): `hits`, the slots the
+// vector test accepted, with their t; `redo`, those whose edge functions came out exactly
+// zero, for the scalar test. `bound`: with Deferred, the end of the interval the chosen
+// slot was accepted in (tmax, or an earlier slot's t), for its check.
+template <Query query, Confirm confirm, typename Count>
 __attribute__((always_inline)) inline int confirm_hits(const TrianglePack& p, const PackRay& r, float tnear, float tmax,
                                                        vfp t, unsigned hits, unsigned redo, float& t_hit,
-                                                       ExactCheck& check, Count& count) {
+                                                       ExactCheck& check, float& bound, Count& count) {
   auto vertex = [&](int v, int slot) { return Vec3(p.v[v][0][slot], p.v[v][1][slot], p.v[v][2][slot]); };
-  auto exact = [&](int slot) {
-    count.exact();
-    if constexpr (Refine) {
-      return exact_check(r.ray, vertex(0, slot), vertex(1, slot), vertex(2, slot), tnear, tmax);
+  int best = -1;
+  // Whether `slot` counts; for Exact and Interval, measured against (tnear, end].
+  auto accept = [&](int slot) {
+    const float end = best < 0 ? tmax : t_hit;
+    if constexpr (confirm == Confirm::Deferred) {
+      bound = end;
+      return true;
+    } else if constexpr (confirm == Confirm::Interval) {
+      count.exact();
+      return exact_within(r.ray, vertex(0, slot), vertex(1, slot), vertex(2, slot), tnear, end);
     } else {
-      ExactCheck within;
-      within.within = exact_within(r.ray, vertex(0, slot), vertex(1, slot), vertex(2, slot), tnear, tmax);
-      return within;
+      count.exact();
+      const ExactCheck e = exact_check(r.ray, vertex(0, slot), vertex(1, slot), vertex(2, slot), tnear, end);
+      if (e.within) check = e;
+      return e.within;
     }
   };
-  int best = -1;
   for (; hits; hits &= hits - 1) {
     const int slot = __builtin_ctz(hits);
     if (best >= 0 && !(t[slot] < t_hit)) continue;
-    const ExactCheck e = exact(slot);
-    if (!e.within) continue;
-    best = slot, t_hit = t[slot], check = e;
+    if (!accept(slot)) continue;
+    best = slot, t_hit = t[slot];
     if (query == Query::Any) return best;
   }
   for (; redo; redo &= redo - 1) {
@@ -207,9 +222,8 @@ __attribute__((always_inline)) inline int confirm_hits(const TrianglePack& p, co
     if (!intersect_watertight(r.shear, tnear, best < 0 ? tmax : t_hit, vertex(0, slot), vertex(1, slot),
                               vertex(2, slot), h))
       continue;
-    const ExactCheck e = exact(slot);
-    if (!e.within) continue;
-    best = slot, t_hit = h.t, check = e;
+    if (!accept(slot)) continue;
+    best = slot, t_hit = h.t;
     if (query == Query::Any) return best;
   }
   return best;
@@ -218,11 +232,11 @@ __attribute__((always_inline)) inline int confirm_hits(const TrianglePack& p, co
 // Out of line for closest-hit queries: most packs have no candidate, and the vector test
 // keeps its registers; inline for occlusion, whose first confirmed hit ends the ray (the
 // faster of the two for each, measured).
-template <Query query, bool Refine, typename Count>
+template <Query query, Confirm confirm, typename Count>
 __attribute__((noinline)) int confirm_hits_apart(const TrianglePack& p, const PackRay& r, float tnear, float tmax,
                                                  vfp t, unsigned hits, unsigned redo, float& t_hit, ExactCheck& check,
-                                                 Count& count) {
-  return confirm_hits<query, Refine>(p, r, tnear, tmax, t, hits, redo, t_hit, check, count);
+                                                 float& bound, Count& count) {
+  return confirm_hits<query, confirm>(p, r, tnear, tmax, t, hits, redo, t_hit, check, bound, count);
 }
 
 // The watertight test (cuda/traversal/watertight.h) on a pack of triangles at once, in the
@@ -231,11 +245,11 @@ __attribute__((noinline)) int confirm_hits_apart(const TrianglePack& p, const Pa
 // be hit, since any one will do. A slot whose edge functions come out exactly zero goes
 // to the scalar test, which redoes them in double precision.
 // `skip`: slots a hit filter has already turned down for this ray (0 without a filter).
-// `Refine`: whether the hit will report its exact t, u and v (confirm_hits).
-template <Query query, bool Refine, typename Count>
+// `check` and `bound`: as confirm_hits gives them.
+template <Query query, Confirm confirm, typename Count>
 __attribute__((always_inline)) inline int intersect_pack(const TrianglePack& p, const PackRay& r, float tnear,
-                                                         float tmax, float& t_hit, ExactCheck& check, Count& count,
-                                                         unsigned skip = 0) {
+                                                         float tmax, float& t_hit, ExactCheck& check, float& bound,
+                                                         Count& count, unsigned skip = 0) {
   const RayShear& s = r.shear;
   vfp x[3], y[3], z[3];
   for (int v = 0; v < 3; ++v) {
@@ -261,9 +275,9 @@ __attribute__((always_inline)) inline int intersect_pack(const TrianglePack& p, 
   const unsigned redo = mask_bits(exact_zero) & ~skip;
   if (!(hits | redo)) return -1;
   if constexpr (query == Query::Any)
-    return confirm_hits<query, Refine>(p, r, tnear, tmax, T / det, hits, redo, t_hit, check, count);
+    return confirm_hits<query, confirm>(p, r, tnear, tmax, T / det, hits, redo, t_hit, check, bound, count);
   else
-    return confirm_hits_apart<query, Refine>(p, r, tnear, tmax, T / det, hits, redo, t_hit, check, count);
+    return confirm_hits_apart<query, confirm>(p, r, tnear, tmax, T / det, hits, redo, t_hit, check, bound, count);
 }
 
 // Completes the hit on triangle `found` (hit.t is set): its ids, and unless `refine` is
@@ -297,7 +311,15 @@ inline bool finish(const Tally& t, TraversalCounters* counted, bool found) {
 // With a filter (Filtered), every candidate hit is offered to it before it counts, as
 // Embree offers hits to an application's filter functions; a refused one is skipped and
 // the traversal goes on.
-template <int W, Query query, bool Filtered = false, typename Count = NoTally>
+//
+// Deferred confirmation (Confirm) gives the answer Exact gives. A deferred run accepts every
+// candidate Exact accepts and perhaps more, so its tmax is never above Exact's and it visits
+// no node Exact skips. If its last candidate c passes the check over the interval it was
+// accepted in, Exact also accepts c when it meets it, and would then accept only a nearer
+// candidate, which the deferred run would have met and accepted after c; so both end on c.
+// If c fails, the ray is traced again with Exact.
+template <int W, Query query, bool Filtered = false, typename Count = NoTally,
+          Confirm confirm = Filtered ? Confirm::Exact : query == Query::Any ? Confirm::Interval : Confirm::Deferred>
 bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit, const HitFilter* filter = nullptr,
               Count count = {}, TraversalCounters* counted = nullptr) {
   hit = Hit();
@@ -307,7 +329,8 @@ bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit,
   const PackRay pack_ray(ray, setup);
   float tmax = ray.tfar;
   uint32_t found = kInvalidId;  // the closest hit's triangle so far
-  ExactCheck check;             // and its exact check
+  ExactCheck check;             // and its exact check (Confirm::Exact)
+  float found_bound = 0.0f;     // or the end of the interval it was accepted in (Confirm::Deferred)
   uint32_t sp = 0;
   WideEntry cur{0, 0, ray.tnear};
   for (;;) {
@@ -360,11 +383,12 @@ bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit,
       count.pack(std::min<uint32_t>(kPackWidth, cur.count - (p - cur.ref) * kPackWidth));
       if (!Filtered) {
         ExactCheck e;
-        const int slot =
-            intersect_pack<query, query == Query::Closest>(bvh.packs[p], pack_ray, ray.tnear, tmax, t, e, count);
+        float bound = 0.0f;
+        const int slot = intersect_pack<query, confirm>(bvh.packs[p], pack_ray, ray.tnear, tmax, t, e, bound, count);
         if (slot < 0) continue;
         found = p * kPackWidth + uint32_t(slot);
         check = e;
+        found_bound = bound;
         hit.t = t;
         if (query == Query::Any) return finish(count, counted, finish_hit(bvh, found, check, hit, false));
         tmax = t;
@@ -375,7 +399,8 @@ bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit,
       // the filter refuses is skipped and the next tried.
       for (unsigned skip = 0;;) {
         ExactCheck e;
-        const int slot = intersect_pack<query, true>(bvh.packs[p], pack_ray, ray.tnear, tmax, t, e, count, skip);
+        float bound = 0.0f;
+        const int slot = intersect_pack<query, confirm>(bvh.packs[p], pack_ray, ray.tnear, tmax, t, e, bound, count, skip);
         if (slot < 0) break;
         const uint32_t candidate = p * kPackWidth + uint32_t(slot);
         Hit offered;
@@ -394,7 +419,21 @@ bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit,
     }
   pop:
     do {
-      if (sp == 0) return finish(count, counted, Filtered ? found != kInvalidId : finish_hit(bvh, found, check, hit));
+      if (sp == 0) {
+        if constexpr (confirm == Confirm::Deferred) {
+          if (found != kInvalidId) {
+            const TrianglePack& p = bvh.packs[found / kPackWidth];
+            const uint32_t s = found % kPackWidth;
+            count.exact();
+            check = exact_check(ray, Vec3(p.v[0][0][s], p.v[0][1][s], p.v[0][2][s]),
+                                Vec3(p.v[1][0][s], p.v[1][1][s], p.v[1][2][s]),
+                                Vec3(p.v[2][0][s], p.v[2][1][s], p.v[2][2][s]), ray.tnear, found_bound);
+            if (!check.within)  // a needle's float t was off: once more, every candidate checked
+              return traverse<W, query, false, Count, Confirm::Exact>(bvh, ray, stack, hit, nullptr, count, counted);
+          }
+        }
+        return finish(count, counted, Filtered ? found != kInvalidId : finish_hit(bvh, found, check, hit));
+      }
       cur = stack[--sp];
     } while (cur.entry > tmax);
   }
