@@ -5,8 +5,8 @@
 //   arrays of 2 MiB or more are aligned to 2 MiB and advised as transparent huge pages
 //   (MADV_HUGEPAGE), so they fault once per 2 MiB;
 // - zeroing: std::vector value-initialises what it resizes to, and the layout then writes
-//   every element again; here resize default-initialises (the elements are plain data the
-//   layout writes whole).
+//   every element again; here resize leaves plain data unwritten (the layout writes each
+//   element whole), so the first touch is the fill's, on every thread.
 #pragma once
 
 #include <sys/mman.h>
@@ -46,10 +46,12 @@ struct LayoutAllocator {
   }
   void deallocate(T* p, size_t) noexcept { std::free(p); }
 
-  // Default-initialised, not value-initialised: resize(n) leaves plain data unwritten.
+  // resize(n) leaves plain data unwritten, default member initialisers included (a pack's
+  // ids): such an element is an aggregate of numbers, which the allocation itself brings
+  // into being, and the layout writes it whole before anything reads it.
   template <typename U>
   void construct(U* p) noexcept(std::is_nothrow_default_constructible_v<U>) {
-    ::new (static_cast<void*>(p)) U;
+    if constexpr (!(std::is_trivially_copyable_v<U> && std::is_aggregate_v<U>)) ::new (static_cast<void*>(p)) U;
   }
   template <typename U, typename... Args>
   void construct(U* p, Args&&... args) {
