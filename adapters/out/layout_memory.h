@@ -37,9 +37,9 @@ struct LayoutAllocator {
     if (bytes >= kHugePage) {
       p = std::aligned_alloc(kHugePage, (bytes + kHugePage - 1) / kHugePage * kHugePage);
       if (p) madvise(p, bytes, MADV_HUGEPAGE);  // advice only: where it is refused, small pages
-    } else {
-      p = std::aligned_alloc(alignof(T) > alignof(std::max_align_t) ? alignof(T) : alignof(std::max_align_t),
-                             (bytes + alignof(T) - 1) / alignof(T) * alignof(T));
+    } else {  // aligned_alloc wants a size that is a multiple of the alignment (ASan checks it)
+      constexpr size_t align = alignof(T) > alignof(std::max_align_t) ? alignof(T) : alignof(std::max_align_t);
+      p = std::aligned_alloc(align, (bytes + align) / align * align);
     }
     if (!p) throw std::bad_alloc();
     return static_cast<T*>(p);
