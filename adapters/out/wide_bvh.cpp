@@ -1,6 +1,5 @@
 #include "wide_bvh.h"
 
-#include <cfloat>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -11,20 +10,6 @@
 
 namespace kmbvh {
 namespace {
-
-template <int W>
-WideNode<W> empty_node() {
-  WideNode<W> n;
-  for (int i = 0; i < W; ++i) {
-    for (int d = 0; d < 3; ++d) {
-      n.lo[d][i] = FLT_MAX;
-      n.hi[d][i] = -FLT_MAX;
-    }
-    n.ref[i] = 0;
-    n.count[i] = 1;  // an empty lane is never entered; if it were, it would read as a leaf, not a loop
-  }
-  return n;
-}
 
 // Packs the triangles of leaf n; returns its first pack.
 template <int W>
@@ -67,7 +52,7 @@ WideBvh<W> make_wide_bvh(const Bvh& bvh, LeafTriangles triangles) {
   out.packs.reserve(bvh.prim_indices.size() / 2);
   if (bvh.empty() || (bvh.root().is_leaf() && bvh.root().count == 0)) return out;
   if (bvh.root().is_leaf()) {  // one leaf: a root with a single lane
-    out.nodes.push_back(empty_node<W>());
+    out.nodes.push_back(empty_wide_node<W>());
     set_lane(out, out.nodes[0], 0, bvh.root(), triangles);
     return out;
   }
@@ -77,7 +62,7 @@ WideBvh<W> make_wide_bvh(const Bvh& bvh, LeafTriangles triangles) {
         if (n.count > W)
           throw std::invalid_argument("a " + std::to_string(W) + "-wide layout got a node of " + std::to_string(n.count) +
                                       " children");
-        WideNode<W> node = empty_node<W>();
+        WideNode<W> node = empty_wide_node<W>();
         for (uint32_t c = 0; c < n.count; ++c) set_lane(out, node, int(c), bvh.nodes[n.first + c], triangles);
         out.nodes.push_back(node);
         return uint32_t(out.nodes.size() - 1);

@@ -1,7 +1,6 @@
 #include "wide_layout.h"
 
 #include <algorithm>
-#include <cfloat>
 #include <limits>
 #include <stdexcept>
 #include <string>
@@ -26,20 +25,6 @@ struct Plan {
   LayoutArray<LeafJob> leaves;
   uint32_t packs = 0;
 };
-
-template <int W>
-WideNode<W> empty_node() {
-  WideNode<W> n;
-  for (int i = 0; i < W; ++i) {
-    for (int d = 0; d < 3; ++d) {
-      n.lo[d][i] = FLT_MAX;
-      n.hi[d][i] = -FLT_MAX;
-    }
-    n.ref[i] = 0;
-    n.count[i] = 1;  // as wide_bvh.cpp: never entered, and it would read as a leaf
-  }
-  return n;
-}
 
 // Lane `lane` of `node` for source node `c`; a leaf's packs are reserved in order.
 template <int W>
@@ -66,7 +51,7 @@ Plan<W> plan_layout(const Bvh& bvh, bool collapse) {
   plan.out.nodes.reserve(bvh.nodes.size() / (collapse ? W - 1 : 1) + 1);
   plan.leaves.reserve(bvh.nodes.size() / 2 + 1);
   if (bvh.root().is_leaf()) {  // one leaf: a root with a single lane
-    plan.out.nodes.push_back(empty_node<W>());
+    plan.out.nodes.push_back(empty_wide_node<W>());
     plan_lane(plan, plan.out.nodes[0], 0, bvh, 0);
     return plan;
   }
@@ -90,7 +75,7 @@ Plan<W> plan_layout(const Bvh& bvh, bool collapse) {
       for (uint32_t c = 0; c < count; ++c) children[c] = n.first + c;
     }
     const uint32_t index = uint32_t(plan.out.nodes.size());
-    plan.out.nodes.push_back(empty_node<W>());
+    plan.out.nodes.push_back(empty_wide_node<W>());
     for (uint32_t c = 0; c < count; ++c) plan_lane(plan, plan.out.nodes[index], int(c), bvh, children[c]);
     if (p.parent != UINT32_MAX) plan.out.nodes[p.parent].ref[p.slot] = index;
     max_depth = std::max(max_depth, p.depth);
