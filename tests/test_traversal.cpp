@@ -308,10 +308,7 @@ void expect_one_pass_layout_is_the_reference(const Bvh& bvh, const PrimitiveSet&
                                              const std::vector<PrimitiveId>* reported_ids, const std::string& what) {
   const bool collapse = tree_arity(bvh) <= 2;
   const Bvh tree = collapse ? collapse_to_width(bvh, W) : bvh;
-  LeafTriangles triangles = leaf_triangles(tree, prims, scene);
-  if (reported_ids)
-    for (PrimitiveId& id : triangles.ids) id = (*reported_ids)[id.prim];
-  const WideBvh<W> reference = make_wide_bvh<W>(tree, std::move(triangles));
+  const WideBvh<W> reference = make_wide_bvh<W>(tree, leaf_triangles(tree, prims, scene, reported_ids));
   for (const int threads : {1, 2, 3}) {
     set_thread_count(threads);
     expect_same_layout(lay_out_wide<W>(bvh, prims, scene, collapse, reported_ids), reference,

@@ -49,14 +49,13 @@ Bvh collapse_to_width(const Bvh& bvh, uint32_t width) {
     const auto [from, to] = queue[q];
     const BvhNode& n = bvh.nodes[from];
     if (n.is_leaf()) continue;
-    children.resize(open_children(bvh, from, width, children.data()));
+    const uint32_t count = open_children(bvh, from, width, children.data());
     const uint32_t first = uint32_t(out.nodes.size());
-    out.nodes[to] = BvhNode::make_interior(n.box, first, uint32_t(children.size()));
-    for (const uint32_t c : children) {
-      queue.push_back({c, uint32_t(out.nodes.size())});
-      out.nodes.push_back(bvh.nodes[c]);  // a leaf stays as it is; an interior node is rewritten when dequeued
+    out.nodes[to] = BvhNode::make_interior(n.box, first, count);
+    for (uint32_t i = 0; i < count; ++i) {
+      queue.push_back({children[i], uint32_t(out.nodes.size())});
+      out.nodes.push_back(bvh.nodes[children[i]]);  // a leaf stays as it is; an interior node is rewritten when dequeued
     }
-    children.resize(width);
   }
   return out;
 }

@@ -17,6 +17,9 @@ struct LeafTriangles {
 };
 
 // prims: the set the tree was built over (made from `scene` by make_primitive_set).
-LeafTriangles leaf_triangles(const Bvh& bvh, const PrimitiveSet& prims, const TriangleScene& scene);
+// reported_ids, when given, replaces each id by reported_ids[id.prim] (Embree's ids of a
+// flattened multi-mesh scene); throws std::invalid_argument unless it has one per triangle.
+LeafTriangles leaf_triangles(const Bvh& bvh, const PrimitiveSet& prims, const TriangleScene& scene,
+                             const std::vector<PrimitiveId>* reported_ids = nullptr);
 
 }  // namespace kmbvh

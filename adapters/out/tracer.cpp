@@ -47,17 +47,11 @@ Tracer::Tracer(const Bvh& bvh, const PrimitiveSet& prims, const TriangleScene& s
     throw std::invalid_argument("a " + std::string(to_string(layout)) + " layout needs nodes of at most " +
                                 std::to_string(width) + " children; this tree has " + std::to_string(arity));
   collapsed_ = layout != Layout::Bvh2 && arity <= 2;
-  if (reported_ids && reported_ids->size() != scene.triangles.size())
-    throw std::invalid_argument("Tracer: reported_ids needs one id per triangle of the scene");
-  switch (layout) {
-    case Layout::Bvh2: {
-      LeafTriangles triangles = leaf_triangles(bvh, prims, scene);
-      if (reported_ids)
-        for (PrimitiveId& id : triangles.ids) id = (*reported_ids)[id.prim];
-      layouts_->bvh2 = make_bvh2(bvh, std::move(triangles));
+  switch (layout) {  // each layout checks reported_ids itself
+    case Layout::Bvh2:
+      layouts_->bvh2 = make_bvh2(bvh, leaf_triangles(bvh, prims, scene, reported_ids));
       if (backend == Backend::Cuda) layouts_->bvh2_gpu = std::make_unique<Bvh2OnGpu>(layouts_->bvh2);
       break;
-    }
     case Layout::Bvh4: layouts_->bvh4 = lay_out_wide<4>(bvh, prims, scene, collapsed_, reported_ids); break;
     case Layout::Bvh8: layouts_->bvh8 = lay_out_wide<8>(bvh, prims, scene, collapsed_, reported_ids); break;
   }
