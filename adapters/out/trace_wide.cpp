@@ -5,6 +5,8 @@
 
 #include <algorithm>
 #include <cmath>
+#include <limits>
+#include <new>
 #include <type_traits>
 
 #include "cuda/core/parallel_errors.h"
@@ -40,6 +42,7 @@ namespace wide_sse42 {
 constexpr bool kAvx = false;
 namespace {
 #include "trace_wide_kernel.inl"
+#include "trace_packet_kernel.inl"
 }  // namespace
 }  // namespace wide_sse42
 
@@ -48,6 +51,7 @@ namespace wide_avx2 {
 constexpr bool kAvx = true;
 namespace {
 #include "trace_wide_kernel.inl"
+#include "trace_packet_kernel.inl"
 }  // namespace
 }  // namespace wide_avx2
 KMBVH_TARGET_END
@@ -57,6 +61,7 @@ namespace wide_avx512 {
 constexpr bool kAvx = true;
 namespace {
 #include "trace_wide_kernel.inl"
+#include "trace_packet_kernel.inl"
 }  // namespace
 }  // namespace wide_avx512
 KMBVH_TARGET_END
@@ -68,16 +73,18 @@ template <int W>
 struct Kernels {
   void (*trace_rays)(const WideBvh<W>&, const Ray*, size_t, Query, Hit*, WideEntry*, TraversalCounters*);
   bool (*trace_one)(const WideBvh<W>&, const Ray&, Query, WideEntry*, Hit&, const HitFilter*);
+  void (*trace_packet)(const WideBvh<W>&, const Ray*, unsigned, Query, Hit*, TraversalCounters*);
+  void (*trace_packets)(const WideBvh<W>&, const Ray*, size_t, Query, Hit*, TraversalCounters*);
 };
 
 template <int W>
 Kernels<W> kernels(CpuIsa isa) {
   switch (isa) {
-    case CpuIsa::Avx512: return {wide_avx512::trace_rays<W>, wide_avx512::trace_one<W>};
-    case CpuIsa::Avx2: return {wide_avx2::trace_rays<W>, wide_avx2::trace_one<W>};
+    case CpuIsa::Avx512: return {wide_avx512::trace_rays<W>, wide_avx512::trace_one<W>, wide_avx512::trace_packet<W>, wide_avx512::trace_packets<W>};
+    case CpuIsa::Avx2: return {wide_avx2::trace_rays<W>, wide_avx2::trace_one<W>, wide_avx2::trace_packet<W>, wide_avx2::trace_packets<W>};
     case CpuIsa::Sse42: break;
   }
-  return {wide_sse42::trace_rays<W>, wide_sse42::trace_one<W>};
+  return {wide_sse42::trace_rays<W>, wide_sse42::trace_one<W>, wide_sse42::trace_packet<W>, wide_sse42::trace_packets<W>};
 }
 
 // The process's choice (cpu_isa.h: traversal_isa), looked up once.
@@ -111,25 +118,22 @@ void trace_wide(const WideBvh<W>& bvh, const Ray* rays, size_t n, Query query, H
   trace_wide(bvh, rays, n, query, hits, counters, traversal_isa());
 }
 
-template <int W>
-void trace_wide(const WideBvh<W>& bvh, const Ray* rays, size_t n, Query query, Hit* hits, TraversalCounters* counters,
-                CpuIsa isa) {
-  if (!cpu_runs(isa)) throw std::invalid_argument(std::string("trace_wide: this CPU does not run ") + to_string(isa));
-  const Kernels<W> k = kernels<W>(isa);
-  constexpr size_t kChunk = 256;  // rays a thread takes at a time
+// A batch split across threads in chunks, each chunk traced by `chunk(first, size, counters)`.
+template <typename TraceChunk>
+void trace_in_chunks(size_t n, uint32_t stack_size, TraversalCounters* counters, const TraceChunk& chunk) {
+  constexpr size_t kChunk = 256;  // rays a thread takes at a time (whole packets)
   const size_t chunks = (n + kChunk - 1) / kChunk;
   ParallelErrors errors;
 #pragma omp parallel
   {
     std::vector<WideEntry> stack;
     TraversalCounters mine;
-    errors.capture([&] { stack.resize(bvh.stack_size); });
+    errors.capture([&] { stack.resize(stack_size); });
 #pragma omp for schedule(dynamic, 1)
     for (size_t c = 0; c < chunks; ++c) {
       if (errors.failed()) continue;
       const size_t first = c * kChunk;
-      k.trace_rays(bvh, rays + first, std::min(kChunk, n - first), query, hits + first, stack.data(),
-                   counters ? &mine : nullptr);
+      errors.capture([&] { chunk(first, std::min(kChunk, n - first), stack.data(), counters ? &mine : nullptr); });
     }
     if (counters) {
 #pragma omp critical(kmbvh_traversal_counters)
@@ -137,6 +141,33 @@ void trace_wide(const WideBvh<W>& bvh, const Ray* rays, size_t n, Query query, H
     }
   }
   errors.rethrow();
+}
+
+template <int W>
+void trace_wide(const WideBvh<W>& bvh, const Ray* rays, size_t n, Query query, Hit* hits, TraversalCounters* counters,
+                CpuIsa isa) {
+  if (!cpu_runs(isa)) throw std::invalid_argument(std::string("trace_wide: this CPU does not run ") + to_string(isa));
+  const Kernels<W> k = kernels<W>(isa);
+  trace_in_chunks(n, bvh.stack_size, counters, [&](size_t first, size_t size, WideEntry* stack, TraversalCounters* mine) {
+    k.trace_rays(bvh, rays + first, size, query, hits + first, stack, mine);
+  });
+}
+
+template <int W>
+void trace_wide_packets(const WideBvh<W>& bvh, const Ray* rays, size_t n, Query query, Hit* hits,
+                        TraversalCounters* counters, CpuIsa isa) {
+  if (!cpu_runs(isa))
+    throw std::invalid_argument(std::string("trace_wide_packets: this CPU does not run ") + to_string(isa));
+  const Kernels<W> k = kernels<W>(isa);
+  trace_in_chunks(n, bvh.stack_size, counters, [&](size_t first, size_t size, WideEntry*, TraversalCounters* mine) {
+    k.trace_packets(bvh, rays + first, size, query, hits + first, mine);
+  });
+}
+
+template <int W>
+void trace_wide_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Query query, Hit* hits) {
+  if (valid >> kMaxPacket) throw std::invalid_argument("trace_wide_packet: a packet holds at most 16 rays");
+  chosen_kernels<W>().trace_packet(bvh, rays, valid, query, hits, nullptr);
 }
 
 template bool trace_wide_ray<4>(const WideBvh<4>&, const Ray&, Query, WideEntry*, Hit&);
@@ -148,6 +179,10 @@ template void trace_wide<8>(const WideBvh<8>&, const std::vector<Ray>&, Query, s
 template void trace_wide<4>(const WideBvh<4>&, const Ray*, size_t, Query, Hit*, TraversalCounters*);
 template void trace_wide<8>(const WideBvh<8>&, const Ray*, size_t, Query, Hit*, TraversalCounters*);
 template void trace_wide<4>(const WideBvh<4>&, const Ray*, size_t, Query, Hit*, TraversalCounters*, CpuIsa);
+template void trace_wide_packets<4>(const WideBvh<4>&, const Ray*, size_t, Query, Hit*, TraversalCounters*, CpuIsa);
+template void trace_wide_packets<8>(const WideBvh<8>&, const Ray*, size_t, Query, Hit*, TraversalCounters*, CpuIsa);
+template void trace_wide_packet<4>(const WideBvh<4>&, const Ray*, unsigned, Query, Hit*);
+template void trace_wide_packet<8>(const WideBvh<8>&, const Ray*, unsigned, Query, Hit*);
 template void trace_wide<8>(const WideBvh<8>&, const Ray*, size_t, Query, Hit*, TraversalCounters*, CpuIsa);
 
 }  // namespace kmbvh

@@ -40,6 +40,20 @@ template <int W>
 void trace_wide(const WideBvh<W>& bvh, const Ray* rays, size_t n, Query query, Hit* hits, TraversalCounters* counters,
                 CpuIsa isa);
 
+// Packets of rays traced together (trace_packet_kernel.inl: Embree's hybrid traversal):
+// for coherent rays, such as a camera's primary and shadow rays, fewer node reads and box
+// tests than one ray at a time. A closest hit is the one trace_wide gives, bit for bit; an
+// occlusion query gives the same yes or no (which occluder it names may differ).
+constexpr unsigned kMaxPacket = 16;
+// rays[0, n) in packets of kMaxPacket consecutive rays, split across threads.
+template <int W>
+void trace_wide_packets(const WideBvh<W>& bvh, const Ray* rays, size_t n, Query query, Hit* hits,
+                        TraversalCounters* counters, CpuIsa isa);
+// One packet on the calling thread (rtcIntersect16): bit i of `valid` traces rays[i] into
+// hits[i], other hits are not touched; valid < 2^kMaxPacket, else std::invalid_argument.
+template <int W>
+void trace_wide_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Query query, Hit* hits);
+
 struct WideEntry {
   uint32_t ref, count;  // as in WideNode: count 0 is an interior node
   float entry;          // where the ray enters its box: skipped once a closer hit is known

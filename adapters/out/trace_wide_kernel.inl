@@ -172,6 +172,11 @@ struct PackRay {
   }
 };
 
+// Vertex v of a pack's slot.
+inline Vec3 slot_vertex(const TrianglePack& p, int v, uint32_t slot) {
+  return Vec3(p.v[v][0][slot], p.v[v][1][slot], p.v[v][2][slot]);
+}
+
 // How a pack's candidate hits are confirmed in double precision (watertight.h), which
 // keeps a needle's float t from landing on the wrong side of tnear or tmax:
 // - Exact: each by exact_check before it counts, which also gives the t, u and v the hit
@@ -183,19 +188,70 @@ struct PackRay {
 //   the ones later beaten are never measured; the answer is the same (see traverse).
 enum class Confirm { Exact, Interval, Deferred };
 
+// Candidates at one distance are taken in the order of their ids, the lower (geomID, primID)
+// first, so that the closest hit among coincident triangles (a two-sided wall, a mesh
+// duplicated in place) does not depend on the order the traversal meets them in: the
+// packet traversal meets them in another order than a single ray does.
+inline uint64_t tie_key(PrimitiveId id) { return uint64_t(id.geom) << 32 | id.prim; }
+
+// How far past the closest candidate's t the pack test looks once there is one: a triangle
+// at the very same t then passes its scaled interval test (|T| <= tmax |det|) whatever the
+// roundings (8 ulp), and the order is decided on the candidates' t and ids.
+inline float tie_reach(float t) { return t + std::fabs(t) * 0x1p-21f; }
+
+// The boxes a ray enters once it has a candidate at t: those it enters before t, and a
+// little beyond (2^-14 of t). A triangle's float t is off by a few ulp, and on large
+// triangles far from the origin by more; a coincident triangle at the same exact t whose
+// box the ray enters just after the candidate's float t must still be met, or which of the
+// two is the closest hit would depend on which the traversal met first (tie_key).
+inline float cull_reach(float t) { return t + std::fabs(t) * 0x1p-14f; }
+
+// A ray's search as it stands, carried from one descent to the next (the packet traversal
+// hands it to the single-ray descent and back).
+struct Search {
+  float tmax;                   // the interval's end: tfar, then the closest candidate's t
+  float reach;                  // how far the pack test looks: tmax, then tie_reach(tmax)
+  float cull;                   // how far the box tests look: tmax, then cull_reach(tmax)
+  uint32_t found = kInvalidId;  // the closest candidate's triangle
+  uint64_t found_key = 0;       // and its tie_key
+  ExactCheck check;             // and its exact check (Confirm::Exact)
+  float found_bound = 0.0f;     // or the end of the interval it was accepted in (Confirm::Deferred)
+
+  explicit Search(float tfar) : tmax(tfar), reach(tfar), cull(tfar) {}
+  Search() = default;
+  // A closer candidate was found at t.
+  void narrow(float t) {
+    tmax = t;
+    reach = tie_reach(t);
+    cull = cull_reach(t);
+  }
+};
+
 // The candidates of a pack's test, confirmed one by one (Confirm): `hits`, the slots the
 // vector test accepted, with their t; `redo`, those whose edge functions came out exactly
-// zero, for the scalar test. `bound`: with Deferred, the end of the interval the chosen
-// slot was accepted in (tmax, or an earlier slot's t), for its check.
+// zero, for the scalar test. A slot counts if it beats the closest candidate so far (the
+// search's, then this pack's best): nearer, or as near with a lower tie_key. `bound`: with
+// Deferred, the end of the interval the chosen slot was accepted in (tmax, or an earlier
+// slot's t), for its check.
 template <Query query, Confirm confirm, typename Count>
-__attribute__((always_inline)) inline int confirm_hits(const TrianglePack& p, const PackRay& r, float tnear, float tmax,
-                                                       vfp t, unsigned hits, unsigned redo, float& t_hit,
-                                                       ExactCheck& check, float& bound, Count& count) {
-  auto vertex = [&](int v, int slot) { return Vec3(p.v[v][0][slot], p.v[v][1][slot], p.v[v][2][slot]); };
+__attribute__((always_inline)) inline int confirm_hits(const TrianglePack& p, const PackRay& r, float tnear,
+                                                       const Search& search, vfp t, unsigned hits, unsigned redo,
+                                                       float& t_hit, ExactCheck& check, float& bound, Count& count) {
+  auto vertex = [&](int v, int slot) { return slot_vertex(p, v, uint32_t(slot)); };
+  const float tmax = search.tmax;
+  const bool prior = search.found != kInvalidId;
   int best = -1;
-  // Whether `slot` counts; for Exact and Interval, measured against (tnear, end].
+  auto beats = [&](int slot, float ts) {
+    if (best < 0 && !prior) return true;  // the test admitted it within (tnear, tfar]
+    const float tb = best < 0 ? tmax : t_hit;
+    if (ts != tb) return ts < tb;
+    return tie_key(p.id[slot]) < (best < 0 ? search.found_key : tie_key(p.id[best]));
+  };
+  // Whether `slot` counts; for Exact and Interval, measured against (tnear, end]: tfar for
+  // the first candidate, then a little past the closest one's float t (cull_reach), which
+  // may be an ulp below the exact t of both when they are coincident.
   auto accept = [&](int slot) {
-    const float end = best < 0 ? tmax : t_hit;
+    const float end = best < 0 ? (prior ? cull_reach(tmax) : tmax) : cull_reach(t_hit);
     if constexpr (confirm == Confirm::Deferred) {
       bound = end;
       return true;
@@ -211,7 +267,7 @@ __attribute__((always_inline)) inline int confirm_hits(const TrianglePack& p, co
   };
   for (; hits; hits &= hits - 1) {
     const int slot = __builtin_ctz(hits);
-    if (best >= 0 && !(t[slot] < t_hit)) continue;
+    if (!beats(slot, t[slot])) continue;
     if (!accept(slot)) continue;
     best = slot, t_hit = t[slot];
     if (query == Query::Any) return best;
@@ -219,9 +275,9 @@ __attribute__((always_inline)) inline int confirm_hits(const TrianglePack& p, co
   for (; redo; redo &= redo - 1) {
     const int slot = __builtin_ctz(redo);
     Hit h;
-    if (!intersect_watertight(r.shear, tnear, best < 0 ? tmax : t_hit, vertex(0, slot), vertex(1, slot),
-                              vertex(2, slot), h))
-      continue;
+    const float reach = best < 0 ? search.reach : tie_reach(t_hit);
+    if (!intersect_watertight(r.shear, tnear, reach, vertex(0, slot), vertex(1, slot), vertex(2, slot), h)) continue;
+    if (!beats(slot, h.t)) continue;
     if (!accept(slot)) continue;
     best = slot, t_hit = h.t;
     if (query == Query::Any) return best;
@@ -233,23 +289,24 @@ __attribute__((always_inline)) inline int confirm_hits(const TrianglePack& p, co
 // keeps its registers; inline for occlusion, whose first confirmed hit ends the ray (the
 // faster of the two for each, measured).
 template <Query query, Confirm confirm, typename Count>
-__attribute__((noinline)) int confirm_hits_apart(const TrianglePack& p, const PackRay& r, float tnear, float tmax,
-                                                 vfp t, unsigned hits, unsigned redo, float& t_hit, ExactCheck& check,
-                                                 float& bound, Count& count) {
-  return confirm_hits<query, confirm>(p, r, tnear, tmax, t, hits, redo, t_hit, check, bound, count);
+__attribute__((noinline)) int confirm_hits_apart(const TrianglePack& p, const PackRay& r, float tnear,
+                                                 const Search& search, vfp t, unsigned hits, unsigned redo,
+                                                 float& t_hit, ExactCheck& check, float& bound, Count& count) {
+  return confirm_hits<query, confirm>(p, r, tnear, search, t, hits, redo, t_hit, check, bound, count);
 }
 
 // The watertight test (cuda/traversal/watertight.h) on a pack of triangles at once, in the
 // same operations as the scalar test. Returns the slot of the nearest hit in (tnear,
-// tmax], its float t and its exact check, or -1; for Query::Any, the first slot found to
+// search.tmax] that beats the search's candidate (confirm_hits), its float t and its exact
+// check, or -1; for Query::Any, the first slot found to
 // be hit, since any one will do. A slot whose edge functions come out exactly zero goes
 // to the scalar test, which redoes them in double precision.
 // `skip`: slots a hit filter has already turned down for this ray (0 without a filter).
 // `check` and `bound`: as confirm_hits gives them.
 template <Query query, Confirm confirm, typename Count>
 __attribute__((always_inline)) inline int intersect_pack(const TrianglePack& p, const PackRay& r, float tnear,
-                                                         float tmax, float& t_hit, ExactCheck& check, float& bound,
-                                                         Count& count, unsigned skip = 0) {
+                                                         const Search& search, float& t_hit, ExactCheck& check,
+                                                         float& bound, Count& count, unsigned skip = 0) {
   const RayShear& s = r.shear;
   vfp x[3], y[3], z[3];
   for (int v = 0; v < 3; ++v) {
@@ -269,15 +326,15 @@ __attribute__((always_inline)) inline int intersect_pack(const TrianglePack& p, 
   const vip sign = vip(det) & (vip{} + int(0x80000000));
   const vfp abs_det = vfp(vip(det) ^ sign), abs_T = vfp(vip(T) ^ sign);
   const vip valid =
-      ~(negative & positive) & (det != zero) & (abs_T > r.tnear * abs_det) & (abs_T <= splat<vfp>(tmax) * abs_det);
+      ~(negative & positive) & (det != zero) & (abs_T > r.tnear * abs_det) & (abs_T <= splat<vfp>(search.reach) * abs_det);
   const vip exact_zero = (U == zero) | (V == zero) | (W == zero);
   const unsigned hits = mask_bits(valid & ~exact_zero) & ~skip;
   const unsigned redo = mask_bits(exact_zero) & ~skip;
   if (!(hits | redo)) return -1;
   if constexpr (query == Query::Any)
-    return confirm_hits<query, confirm>(p, r, tnear, tmax, T / det, hits, redo, t_hit, check, bound, count);
+    return confirm_hits<query, confirm>(p, r, tnear, search, T / det, hits, redo, t_hit, check, bound, count);
   else
-    return confirm_hits_apart<query, confirm>(p, r, tnear, tmax, T / det, hits, redo, t_hit, check, bound, count);
+    return confirm_hits_apart<query, confirm>(p, r, tnear, search, T / det, hits, redo, t_hit, check, bound, count);
 }
 
 // Completes the hit on triangle `found` (hit.t is set): its ids, and unless `refine` is
@@ -291,9 +348,7 @@ __attribute__((always_inline)) inline bool finish_hit(const WideBvh<W>& bvh, uin
   hit.geomID = p.id[slot].geom;
   hit.primID = p.id[slot].prim;
   if (!refine) return true;
-  const Vec3 a(p.v[0][0][slot], p.v[0][1][slot], p.v[0][2][slot]);
-  const Vec3 b(p.v[1][0][slot], p.v[1][1][slot], p.v[1][2][slot]);
-  const Vec3 c(p.v[2][0][slot], p.v[2][1][slot], p.v[2][2][slot]);
+  const Vec3 a = slot_vertex(p, 0, slot), b = slot_vertex(p, 1, slot), c = slot_vertex(p, 2, slot);
   hit.Ng = cross(b - a, c - a);
   apply_exact_check(check, a, b, c, hit);
   return true;
@@ -321,18 +376,16 @@ inline bool finish(const Tally& t, TraversalCounters* counted, bool found) {
 template <int W, Query query, bool Filtered = false, typename Count = NoTally,
           Confirm confirm = Filtered ? Confirm::Exact : query == Query::Any ? Confirm::Interval : Confirm::Deferred>
 bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit, const HitFilter* filter = nullptr,
-              Count count = {}, TraversalCounters* counted = nullptr) {
-  hit = Hit();
-  if (bvh.nodes.empty() || !ray_can_hit(ray)) return finish(count, counted, false);
-  const RaySetup setup(ray);
-  const WideRay<W> wray(ray, setup);
-  const PackRay pack_ray(ray, setup);
-  float tmax = ray.tfar;
-  uint32_t found = kInvalidId;  // the closest hit's triangle so far
-  ExactCheck check;             // and its exact check (Confirm::Exact)
-  float found_bound = 0.0f;     // or the end of the interval it was accepted in (Confirm::Deferred)
+              Count count = {}, TraversalCounters* counted = nullptr);
+
+// Descends from `cur` (a node or leaf the ray enters) until the stack is empty, with the
+// search as it stands. Returns true when that answers the ray (an occlusion query's first
+// hit, `hit` complete); false when the search goes on or is to be concluded (conclude).
+template <int W, Query query, bool Filtered, Confirm confirm, typename Count>
+__attribute__((always_inline)) inline bool descend(const WideBvh<W>& bvh, const Ray& ray, const WideRay<W>& wray,
+                                                   const PackRay& pack_ray, WideEntry cur, WideEntry* stack,
+                                                   Search& s, Hit& hit, const HitFilter* filter, Count& count) {
   uint32_t sp = 0;
-  WideEntry cur{0, 0, ray.tnear};
   for (;;) {
     if (cur.count == 0) {
       const WideNode<W>& n = bvh.nodes[cur.ref];
@@ -341,7 +394,7 @@ bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit,
       // box test is done: fetch that line now, alongside the boxes.
       _mm_prefetch(reinterpret_cast<const char*>(n.ref), _MM_HINT_T0);
       typename Lanes<W>::V entry;
-      unsigned mask = enter_children(n, wray, tmax, entry);
+      unsigned mask = enter_children(n, wray, s.cull, entry);
       if (mask == 0) goto pop;
       int lane = __builtin_ctz(mask);
       mask &= mask - 1;
@@ -384,14 +437,15 @@ bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit,
       if (!Filtered) {
         ExactCheck e;
         float bound = 0.0f;
-        const int slot = intersect_pack<query, confirm>(bvh.packs[p], pack_ray, ray.tnear, tmax, t, e, bound, count);
+        const int slot = intersect_pack<query, confirm>(bvh.packs[p], pack_ray, ray.tnear, s, t, e, bound, count);
         if (slot < 0) continue;
-        found = p * kPackWidth + uint32_t(slot);
-        check = e;
-        found_bound = bound;
+        s.found = p * kPackWidth + uint32_t(slot);
+        s.found_key = tie_key(bvh.packs[p].id[slot]);
+        s.check = e;
+        s.found_bound = bound;
         hit.t = t;
-        if (query == Query::Any) return finish(count, counted, finish_hit(bvh, found, check, hit, false));
-        tmax = t;
+        if (query == Query::Any) return finish_hit(bvh, s.found, s.check, hit, false);
+        s.narrow(t);
         continue;
       }
       // For the closest hit, the pack's nearest slot first; for occlusion, the first slot
@@ -400,7 +454,8 @@ bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit,
       for (unsigned skip = 0;;) {
         ExactCheck e;
         float bound = 0.0f;
-        const int slot = intersect_pack<query, confirm>(bvh.packs[p], pack_ray, ray.tnear, tmax, t, e, bound, count, skip);
+        const int slot =
+            intersect_pack<query, confirm>(bvh.packs[p], pack_ray, ray.tnear, s, t, e, bound, count, skip);
         if (slot < 0) break;
         const uint32_t candidate = p * kPackWidth + uint32_t(slot);
         Hit offered;
@@ -411,32 +466,54 @@ bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit,
           continue;
         }
         hit = offered;
-        if (query == Query::Any) return finish(count, counted, true);
-        found = candidate;
-        tmax = t;
+        if (query == Query::Any) return true;
+        s.found = candidate;
+        s.found_key = tie_key(bvh.packs[p].id[slot]);
+        s.narrow(t);
         break;  // the pack's other slots are farther
       }
     }
   pop:
     do {
-      if (sp == 0) {
-        if constexpr (confirm == Confirm::Deferred) {
-          if (found != kInvalidId) {
-            const TrianglePack& p = bvh.packs[found / kPackWidth];
-            const uint32_t s = found % kPackWidth;
-            count.exact();
-            check = exact_check(ray, Vec3(p.v[0][0][s], p.v[0][1][s], p.v[0][2][s]),
-                                Vec3(p.v[1][0][s], p.v[1][1][s], p.v[1][2][s]),
-                                Vec3(p.v[2][0][s], p.v[2][1][s], p.v[2][2][s]), ray.tnear, found_bound);
-            if (!check.within)  // a needle's float t was off: once more, every candidate checked
-              return traverse<W, query, false, Count, Confirm::Exact>(bvh, ray, stack, hit, nullptr, count, counted);
-          }
-        }
-        return finish(count, counted, Filtered ? found != kInvalidId : finish_hit(bvh, found, check, hit));
-      }
+      if (sp == 0) return false;
       cur = stack[--sp];
-    } while (cur.entry > tmax);
+    } while (cur.entry > s.cull * kRobustExit);  // with the box test's margin, as enter_children
   }
+}
+
+// The answer once every descent is over: with Deferred, the closest candidate's exact check
+// over the interval it was accepted in (a failed one traces the ray again with Exact);
+// then its hit completed.
+template <int W, Query query, bool Filtered, Confirm confirm, typename Count>
+__attribute__((always_inline)) inline bool conclude(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack,
+                                                    Search& s, Hit& hit, Count& count, TraversalCounters* counted) {
+  if constexpr (confirm == Confirm::Deferred) {
+    if (s.found != kInvalidId) {
+      const TrianglePack& p = bvh.packs[s.found / kPackWidth];
+      const uint32_t slot = s.found % kPackWidth;
+      count.exact();
+      s.check = exact_check(ray, slot_vertex(p, 0, slot), slot_vertex(p, 1, slot), slot_vertex(p, 2, slot),
+                            ray.tnear, s.found_bound);
+      if (!s.check.within)  // a needle's float t was off: once more, every candidate checked
+        return traverse<W, query, false, Count, Confirm::Exact>(bvh, ray, stack, hit, nullptr, count, counted);
+    }
+  }
+  return finish(count, counted, Filtered ? s.found != kInvalidId : finish_hit(bvh, s.found, s.check, hit));
+}
+
+template <int W, Query query, bool Filtered, typename Count, Confirm confirm>
+bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit, const HitFilter* filter, Count count,
+              TraversalCounters* counted) {
+  hit = Hit();
+  if (bvh.nodes.empty() || !ray_can_hit(ray)) return finish(count, counted, false);
+  const RaySetup setup(ray);
+  const WideRay<W> wray(ray, setup);
+  const PackRay pack_ray(ray, setup);
+  Search s(ray.tfar);
+  if (descend<W, query, Filtered, confirm>(bvh, ray, wray, pack_ray, WideEntry{0, 0, ray.tnear}, stack, s, hit,
+                                           filter, count))
+    return finish(count, counted, true);
+  return conclude<W, query, Filtered, confirm>(bvh, ray, stack, s, hit, count, counted);
 }
 
 // This instruction set's entry points (trace_wide.cpp dispatches to them). No vector type

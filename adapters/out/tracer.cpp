@@ -134,6 +134,29 @@ bool Tracer::trace_one(const Ray& ray, Query query, Hit& hit, const HitFilter& f
   throw std::logic_error("Tracer::trace_one: hit filters need a bvh4 or bvh8 layout");
 }
 
+void Tracer::trace_packets(const std::vector<Ray>& rays, Query query, std::vector<Hit>& hits,
+                           TraversalCounters* counters) const {
+  hits.resize(rays.size());
+  switch (layout_) {
+    case Layout::Bvh2: return trace(rays, query, hits);
+    case Layout::Bvh4:
+      return trace_wide_packets(layouts_->bvh4, rays.data(), rays.size(), query, hits.data(), counters, traversal_isa());
+    case Layout::Bvh8:
+      return trace_wide_packets(layouts_->bvh8, rays.data(), rays.size(), query, hits.data(), counters, traversal_isa());
+  }
+}
+
+void Tracer::trace_packet(const Ray* rays, unsigned valid, Query query, Hit* hits) const {
+  switch (layout_) {
+    case Layout::Bvh2:
+      if (valid >> kMaxPacket) throw std::invalid_argument("Tracer::trace_packet: a packet holds at most 16 rays");
+      for (; valid; valid &= valid - 1) trace_one(rays[__builtin_ctz(valid)], query, hits[__builtin_ctz(valid)]);
+      return;
+    case Layout::Bvh4: return trace_wide_packet(layouts_->bvh4, rays, valid, query, hits);
+    case Layout::Bvh8: return trace_wide_packet(layouts_->bvh8, rays, valid, query, hits);
+  }
+}
+
 double Tracer::last_kernel_ms() const { return layouts_->bvh2_gpu ? layouts_->bvh2_gpu->last_kernel_ms() : 0.0; }
 
 template <int W>

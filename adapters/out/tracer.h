@@ -57,6 +57,16 @@ class Tracer {
   // layout only (throws std::logic_error for bvh2).
   bool trace_one(const Ray& ray, Query query, Hit& hit, const HitFilter& filter) const;
 
+  // Rays in packets of kMaxPacket consecutive rays, each traced together on the CPU
+  // (trace_wide.h: trace_wide_packets), counted into `counters` when it is not null; the
+  // same closest hits as trace(), and the same yes or no for occlusion. bvh2 has no packet
+  // kernel: its rays go one at a time (and count nothing).
+  void trace_packets(const std::vector<Ray>& rays, Query query, std::vector<Hit>& hits,
+                     TraversalCounters* counters = nullptr) const;
+  // One packet on the calling thread, as trace_one (rtcIntersect16): bit i of `valid`
+  // (below 2^kMaxPacket) traces rays[i] into hits[i]; other hits are not touched.
+  void trace_packet(const Ray* rays, unsigned valid, Query query, Hit* hits) const;
+
   Layout layout() const { return layout_; }
   bool collapsed() const { return collapsed_; }  // a binary tree collapsed for a wide layout
   double layout_ms() const { return layout_ms_; }

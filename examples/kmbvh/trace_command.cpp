@@ -1,9 +1,11 @@
 // kmbvh trace SCENE --builder B --layout L --rays K --count N --compare-embree: the same
 // rays through kmbvh's traversal over B's tree and through Embree's own scene, every
-// difference counted, and the speed of both (docs/design.md §6).
+// difference counted, and the speed of both (docs/design.md §6); on the wide layouts the
+// same rays in packets of 16 too, against Embree's rtcIntersect16/rtcOccluded16.
 #include <fmt/format.h>
 
 #include <chrono>
+#include <cstring>
 #include <functional>
 #include <nlohmann/json.hpp>
 #include <optional>
@@ -75,6 +77,12 @@ struct KindResult {
   const EmbreeResult* embree = nullptr;
   HitComparison comparison;
   std::optional<TraversalCounters> counters;  // wide layouts
+  // Wide layouts: the same rays in packets of 16 (Tracer::trace_packets), against Embree's
+  // rtcIntersect16/rtcOccluded16 timed in pairs with them; rays whose packet answer is not
+  // the single-ray answer (closest hit: bit for bit; occlusion: yes or no), which must be 0.
+  double packet_mrays = 0, packet_embree_mrays = 0, packet_ratio = 0;
+  size_t packet_differences = 0;
+  std::optional<TraversalCounters> packet_counters;
 };
 
 // A count over the batch's rays, as an average per ray.
@@ -97,6 +105,39 @@ void print_counters(const KindResult& r) {
   const TraversalCounters& c = *r.counters;
   fmt::print("  {} per ray: {:.2f} nodes, {:.2f} leaf packs, {:.2f} triangles, {:.2f} exact checks\n", to_string(r.kind),
              per_ray(c.nodes, c), per_ray(c.packs, c), per_ray(c.triangles, c), per_ray(c.exact_checks, c));
+}
+
+
+void print_packets(const KindResult& r) {
+  if (!r.packet_counters) return;
+  const TraversalCounters& c = *r.packet_counters;
+  fmt::print("  {} in packets of 16: {:.2f} Mrays/s", to_string(r.kind), r.packet_mrays);
+  if (r.embree) fmt::print(", rtc*16 {:.2f} Mrays/s, ratio {:.2f}", r.packet_embree_mrays, r.packet_ratio);
+  fmt::print("; per ray {:.2f} nodes, {:.2f} leaf packs; {} differ from single rays\n", per_ray(c.nodes, c),
+             per_ray(c.packs, c), r.packet_differences);
+}
+
+// The rays once more in packets of 16: timed (in pairs with Embree's packets when it is
+// there), counted, and checked against the single-ray answers `single`.
+void trace_in_packets(const Tracer& tracer, const std::vector<Ray>& rays, Query query, const std::vector<Hit>& single,
+                      const EmbreeScene* embree, const RunOptions& run, KindResult& r) {
+  std::vector<Hit> hits, embree_hits;
+  const auto ours = [&] { tracer.trace_packets(rays, query, hits); };
+  if (embree) {
+    const PairedTimes t = time_in_pairs(run.runs, run.warmup, ours,
+                                        [&] { embree->trace(rays, query, EmbreeRays::Packet16, embree_hits); });
+    r.packet_mrays = mrays(rays.size(), t.ours_seconds);
+    r.packet_embree_mrays = mrays(rays.size(), t.theirs_seconds);
+    r.packet_ratio = t.ratio;
+  } else {
+    r.packet_mrays = mrays(rays.size(), median_seconds(run.runs, run.warmup, ours));
+  }
+  TraversalCounters counters;
+  tracer.trace_packets(rays, query, hits, &counters);
+  r.packet_counters = counters;
+  for (size_t i = 0; i < rays.size(); ++i)
+    r.packet_differences += query == Query::Any ? hits[i].found() != single[i].found()
+                                                : std::memcmp(&hits[i], &single[i], sizeof(Hit)) != 0;
 }
 
 void print_kernel_rate(const KindResult& r) {
@@ -234,6 +275,10 @@ int run_trace(const TraceCommand& c) {
       }
       r.kernel_mrays = mrays(r.rays, median(kernel_ms) * 1e-3);
       r.counters = tracer.count(rays.of(kind), query_for(kind));
+      if (layout != Layout::Bvh2) {
+        trace_in_packets(tracer, rays.of(kind), query_for(kind), hits, embree ? &*embree : nullptr, c.run, r);
+        mismatches += r.packet_differences;  // a packet must answer as its rays alone would
+      }
       if (embree) {
         r.embree = &embree_results[int(kind)];
         r.comparison = compare_hits(scene.geometry, rays.of(kind), query_for(kind), hits, r.embree->hits, c.show);
@@ -248,6 +293,12 @@ int run_trace(const TraceCommand& c) {
         Json k{{"kind", to_string(r.kind)}, {"rays", r.rays}, {"kmbvh_mrays_per_s", r.mrays}};
         if (r.kernel_mrays > 0) k["kmbvh_kernel_mrays_per_s"] = r.kernel_mrays;
         if (r.counters) k["counters"] = counters_json(*r.counters);
+        if (r.packet_counters) {
+          k["kmbvh16_mrays_per_s"] = r.packet_mrays;
+          k["packet_counters"] = counters_json(*r.packet_counters);
+          k["packet_differences"] = r.packet_differences;
+          if (r.embree) k["ratio16_to_embree16"] = r.packet_ratio;
+        }
         if (r.embree) {
           k["embree_mrays_per_s"] = r.embree_mrays;
           k["embree16_mrays_per_s"] = r.embree->packet_mrays;
@@ -276,6 +327,7 @@ int run_trace(const TraceCommand& c) {
         fmt::print("{:<8} {:>8} {:>13.2f}\n", to_string(r.kind), r.rays, r.mrays);
         print_kernel_rate(r);
         print_counters(r);
+        print_packets(r);
         continue;
       }
       fmt::print("{:<8} {:>8} {:>13.2f} {:>13.2f} {:>7.2f} {:>13.2f} {:>10} {:>9}\n", to_string(r.kind), r.rays, r.mrays,
@@ -283,6 +335,7 @@ int run_trace(const TraceCommand& c) {
                  r.embree->packet_mrays, r.comparison.mismatches(), r.comparison.edge_ties);
       print_kernel_rate(r);
       print_counters(r);
+      print_packets(r);
       const HitComparison& m = r.comparison;
       if (m.mismatches())
         fmt::print("  {} {} mismatches: hit/miss {}, distance {}, primitive {}, normal {}, barycentrics {}\n",

@@ -1,12 +1,16 @@
 // Embree's ray queries, for LD_PRELOAD: a scene kmbvh built answers them with kmbvh's
-// traversal, one ray at a time on the calling thread (rays come from many application
-// threads); any other scene, and any call with a context filter function, goes to Embree.
+// traversal on the calling thread (rays come from many application threads), packets and
+// streams in packets of up to 16 rays traced together (the same answers as one at a time);
+// any other scene, and any call with a context filter function, goes to Embree.
 //
 // Embree's conventions, as Debian's Embree 3.13.5 behaves (measured): on a hit, tfar, Ng,
 // u, v, primID, geomID are written and instID[0] gets the context's instID[0]; on a miss
 // nothing is written. Occluded rays get tfar = -inf. A ray of mask 0 hits nothing (every
 // geometry kmbvh answers for has the default mask). Packet lanes are active where valid
 // is -1.
+#include <algorithm>
+#include <optional>
+
 #include "ab_mode.h"
 #include "plugin/real_embree.h"
 #include "ray_ref.h"
@@ -44,29 +48,65 @@ inline void to_embree(RTCScene scene, const RTCIntersectContext* context, QueryF
   if (ab_mode_on()) ab_count_embree(scene, form, rays, context && context->filter);
 }
 
+unsigned count_valid(const int* valid, unsigned n) {
+  unsigned count = 0;
+  for (unsigned i = 0; valid && i < n; ++i) count += valid[i] == -1;
+  return count;
+}
+
+// The rays 0..n-1 of one call, ray i at ref_of(i) (std::nullopt: an inactive lane, a null
+// pointer): in packets of up to kMaxPacket rays (Tracer::trace_packet), or one at a time
+// where hits are offered to the application's filter functions (in traversal order, as
+// Embree offers them) or the A/B mode compares each query.
+template <typename RefOf>
+void answer_rays(const SceneAccel& accel, RTCScene scene, Query query, RTCIntersectContext* context, QueryForm form,
+                 unsigned n, const RefOf& ref_of) {
+  if (ab_mode_on() || accel.has_filters(query)) {
+    for (unsigned i = 0; i < n; ++i)
+      if (const std::optional<RayRef> r = ref_of(i)) answer(accel, scene, *r, query, context, form);
+    return;
+  }
+  const unsigned inst_id = context_inst_id(context);
+  for (unsigned first = 0; first < n; first += kMaxPacket) {
+    RayRef refs[kMaxPacket];
+    Ray rays[kMaxPacket];
+    Hit hits[kMaxPacket];
+    unsigned valid = 0;
+    for (unsigned i = 0, size = std::min(kMaxPacket, n - first); i < size; ++i) {
+      const std::optional<RayRef> r = ref_of(first + i);
+      if (!r || *r->mask == 0) continue;  // mask 0 hits nothing (SceneAccel::trace)
+      refs[i] = *r;
+      rays[i] = kmbvh_ray(*r);
+      valid |= 1u << i;
+    }
+    if (!valid) continue;
+    accel.trace_packet(rays, valid, query, hits);
+    for (; valid; valid &= valid - 1) {
+      const unsigned i = __builtin_ctz(valid);
+      write_answer(refs[i], query, hits[i], inst_id);
+    }
+  }
+}
+
 // A 4-, 8- or 16-wide packet: RTCRayHitK is {RTCRayK ray; RTCHitK hit;}, both SoA.
 template <unsigned N, typename RayHitK>
 void intersect_packet(const SceneAccel& accel, RTCScene scene, const int* valid, RayHitK* rh,
                       RTCIntersectContext* context, QueryForm form) {
-  unsigned count = 0;
-  for (unsigned i = 0; i < N; ++i)
-    if (valid[i] == -1) answer(accel, scene, lane_ref(&rh->ray, &rh->hit, N, i), Query::Closest, context, form), ++count;
-  count_kmbvh_rays(count);
+  answer_rays(accel, scene, Query::Closest, context, form, N, [&](unsigned i) -> std::optional<RayRef> {
+    if (valid[i] != -1) return std::nullopt;
+    return lane_ref(&rh->ray, &rh->hit, N, i);
+  });
+  count_kmbvh_rays(count_valid(valid, N));
 }
 
 template <unsigned N, typename RayK>
 void occluded_packet(const SceneAccel& accel, RTCScene scene, const int* valid, RayK* r, RTCIntersectContext* context,
                      QueryForm form) {
-  unsigned count = 0;
-  for (unsigned i = 0; i < N; ++i)
-    if (valid[i] == -1) answer(accel, scene, lane_ref(r, nullptr, N, i), Query::Any, context, form), ++count;
-  count_kmbvh_rays(count);
-}
-
-unsigned count_valid(const int* valid, unsigned n) {
-  unsigned count = 0;
-  for (unsigned i = 0; valid && i < n; ++i) count += valid[i] == -1;
-  return count;
+  answer_rays(accel, scene, Query::Any, context, form, N, [&](unsigned i) -> std::optional<RayRef> {
+    if (valid[i] != -1) return std::nullopt;
+    return lane_ref(r, nullptr, N, i);
+  });
+  count_kmbvh_rays(count_valid(valid, N));
 }
 
 }  // namespace
@@ -121,9 +161,9 @@ KMBVH_PACKET(16)
 KMBVH_EXPORT void rtcIntersect1M(RTCScene scene, RTCIntersectContext* context, RTCRayHit* rayhit, unsigned int M,
                                  size_t byteStride) {
   if (const SceneAccel* accel = rayhit ? accel_for(scene, context) : nullptr) {
-    for (unsigned i = 0; i < M; ++i)
-      answer(*accel, scene, ray_ref(*reinterpret_cast<RTCRayHit*>(reinterpret_cast<char*>(rayhit) + i * byteStride)),
-             Query::Closest, context, QueryForm::Intersect1M);
+    answer_rays(*accel, scene, Query::Closest, context, QueryForm::Intersect1M, M, [&](unsigned i) -> std::optional<RayRef> {
+      return ray_ref(*reinterpret_cast<RTCRayHit*>(reinterpret_cast<char*>(rayhit) + i * byteStride));
+    });
     return count_kmbvh_rays(M);
   }
   to_embree(scene, context, QueryForm::Intersect1M, M);
@@ -133,9 +173,9 @@ KMBVH_EXPORT void rtcIntersect1M(RTCScene scene, RTCIntersectContext* context, R
 KMBVH_EXPORT void rtcOccluded1M(RTCScene scene, RTCIntersectContext* context, RTCRay* ray, unsigned int M,
                                 size_t byteStride) {
   if (const SceneAccel* accel = ray ? accel_for(scene, context) : nullptr) {
-    for (unsigned i = 0; i < M; ++i)
-      answer(*accel, scene, ray_ref(*reinterpret_cast<RTCRay*>(reinterpret_cast<char*>(ray) + i * byteStride)),
-             Query::Any, context, QueryForm::Occluded1M);
+    answer_rays(*accel, scene, Query::Any, context, QueryForm::Occluded1M, M, [&](unsigned i) -> std::optional<RayRef> {
+      return ray_ref(*reinterpret_cast<RTCRay*>(reinterpret_cast<char*>(ray) + i * byteStride));
+    });
     return count_kmbvh_rays(M);
   }
   to_embree(scene, context, QueryForm::Occluded1M, M);
@@ -144,8 +184,10 @@ KMBVH_EXPORT void rtcOccluded1M(RTCScene scene, RTCIntersectContext* context, RT
 
 KMBVH_EXPORT void rtcIntersect1Mp(RTCScene scene, RTCIntersectContext* context, RTCRayHit** rayhit, unsigned int M) {
   if (const SceneAccel* accel = rayhit ? accel_for(scene, context) : nullptr) {
-    for (unsigned i = 0; i < M; ++i)
-      if (rayhit[i]) answer(*accel, scene, ray_ref(*rayhit[i]), Query::Closest, context, QueryForm::Intersect1Mp);
+    answer_rays(*accel, scene, Query::Closest, context, QueryForm::Intersect1Mp, M, [&](unsigned i) -> std::optional<RayRef> {
+      if (!rayhit[i]) return std::nullopt;
+      return ray_ref(*rayhit[i]);
+    });
     return count_kmbvh_rays(M);
   }
   to_embree(scene, context, QueryForm::Intersect1Mp, M);
@@ -154,8 +196,10 @@ KMBVH_EXPORT void rtcIntersect1Mp(RTCScene scene, RTCIntersectContext* context, 
 
 KMBVH_EXPORT void rtcOccluded1Mp(RTCScene scene, RTCIntersectContext* context, RTCRay** ray, unsigned int M) {
   if (const SceneAccel* accel = ray ? accel_for(scene, context) : nullptr) {
-    for (unsigned i = 0; i < M; ++i)
-      if (ray[i]) answer(*accel, scene, ray_ref(*ray[i]), Query::Any, context, QueryForm::Occluded1Mp);
+    answer_rays(*accel, scene, Query::Any, context, QueryForm::Occluded1Mp, M, [&](unsigned i) -> std::optional<RayRef> {
+      if (!ray[i]) return std::nullopt;
+      return ray_ref(*ray[i]);
+    });
     return count_kmbvh_rays(M);
   }
   to_embree(scene, context, QueryForm::Occluded1Mp, M);
@@ -169,7 +213,8 @@ KMBVH_EXPORT void rtcIntersectNM(RTCScene scene, RTCIntersectContext* context, R
       auto* packet = reinterpret_cast<RTCRayHitN*>(reinterpret_cast<char*>(rayhit) + m * byteStride);
       void* rays = RTCRayHitN_RayN(packet, N);
       void* hits = RTCRayHitN_HitN(packet, N);
-      for (unsigned i = 0; i < N; ++i) answer(*accel, scene, lane_ref(rays, hits, N, i), Query::Closest, context, QueryForm::IntersectNM);
+      answer_rays(*accel, scene, Query::Closest, context, QueryForm::IntersectNM, N,
+                  [&](unsigned i) -> std::optional<RayRef> { return lane_ref(rays, hits, N, i); });
     }
     return count_kmbvh_rays(uint64_t(N) * M);
   }
@@ -182,7 +227,8 @@ KMBVH_EXPORT void rtcOccludedNM(RTCScene scene, RTCIntersectContext* context, RT
   if (const SceneAccel* accel = ray ? accel_for(scene, context) : nullptr) {
     for (unsigned m = 0; m < M; ++m) {
       void* rays = reinterpret_cast<char*>(ray) + m * byteStride;
-      for (unsigned i = 0; i < N; ++i) answer(*accel, scene, lane_ref(rays, nullptr, N, i), Query::Any, context, QueryForm::OccludedNM);
+      answer_rays(*accel, scene, Query::Any, context, QueryForm::OccludedNM, N,
+                  [&](unsigned i) -> std::optional<RayRef> { return lane_ref(rays, nullptr, N, i); });
     }
     return count_kmbvh_rays(uint64_t(N) * M);
   }
@@ -193,7 +239,8 @@ KMBVH_EXPORT void rtcOccludedNM(RTCScene scene, RTCIntersectContext* context, RT
 KMBVH_EXPORT void rtcIntersectNp(RTCScene scene, RTCIntersectContext* context, const RTCRayHitNp* rayhit,
                                  unsigned int N) {
   if (const SceneAccel* accel = rayhit ? accel_for(scene, context) : nullptr) {
-    for (unsigned i = 0; i < N; ++i) answer(*accel, scene, np_ref(rayhit->ray, &rayhit->hit, i), Query::Closest, context, QueryForm::IntersectNp);
+    answer_rays(*accel, scene, Query::Closest, context, QueryForm::IntersectNp, N,
+                [&](unsigned i) -> std::optional<RayRef> { return np_ref(rayhit->ray, &rayhit->hit, i); });
     return count_kmbvh_rays(N);
   }
   to_embree(scene, context, QueryForm::IntersectNp, N);
@@ -202,7 +249,8 @@ KMBVH_EXPORT void rtcIntersectNp(RTCScene scene, RTCIntersectContext* context, c
 
 KMBVH_EXPORT void rtcOccludedNp(RTCScene scene, RTCIntersectContext* context, const RTCRayNp* ray, unsigned int N) {
   if (const SceneAccel* accel = ray ? accel_for(scene, context) : nullptr) {
-    for (unsigned i = 0; i < N; ++i) answer(*accel, scene, np_ref(*ray, nullptr, i), Query::Any, context, QueryForm::OccludedNp);
+    answer_rays(*accel, scene, Query::Any, context, QueryForm::OccludedNp, N,
+                [&](unsigned i) -> std::optional<RayRef> { return np_ref(*ray, nullptr, i); });
     return count_kmbvh_rays(N);
   }
   to_embree(scene, context, QueryForm::OccludedNp, N);

@@ -1,0 +1,171 @@
+// The packet traversal (adapters/out/trace_packet_kernel.inl): every closest hit the same as
+// the single-ray traversal's, bit for bit, and every occlusion answer the same yes or no,
+// on coherent camera rays, on incoherent random rays (the hybrid's single-ray switch), on
+// coincident triangles, on every stress case, for every instruction set this CPU runs; and
+// on coherent rays it reads fewer nodes, which is its point.
+#include <gtest/gtest.h>
+
+#include <cstring>
+#include <string>
+
+#include "adapters/builder_registry.h"
+#include "adapters/in/default_scene.h"
+#include "adapters/out/collapse_wide.h"
+#include "adapters/out/leaf_triangles.h"
+#include "adapters/out/tracer.h"
+#include "adapters/rays/scene_rays.h"
+#include "support/builder_specs.h"
+#include "support/rays.h"
+#include "support/scenes.h"
+
+namespace kmbvh {
+namespace {
+
+// Packets against single rays, both queries, every instruction set.
+template <int W>
+void expect_packets_match_single_rays(const WideBvh<W>& wide, const std::vector<Ray>& rays, const std::string& what) {
+  for (const Query query : {Query::Closest, Query::Any}) {
+    std::vector<Hit> single(rays.size());
+    trace_wide(wide, rays.data(), rays.size(), query, single.data());
+    for (const CpuIsa isa : cpu_isas()) {
+      std::vector<Hit> packets(rays.size());
+      trace_wide_packets(wide, rays.data(), rays.size(), query, packets.data(), nullptr, isa);
+      for (size_t r = 0; r < rays.size(); ++r) {
+        const std::string where = what + ", bvh" + std::to_string(W) + ", " + to_string(isa) + ", " +
+                                  (query == Query::Any ? "occlusion" : "closest") + ", ray " + std::to_string(r);
+        if (query == Query::Closest) {
+          ASSERT_EQ(std::memcmp(&packets[r], &single[r], sizeof(Hit)), 0) << where;
+        } else {
+          ASSERT_EQ(packets[r].found(), single[r].found()) << where;
+        }
+      }
+    }
+  }
+}
+
+void expect_packets_match(const TriangleScene& scene, const std::vector<Ray>& rays, const std::string& what,
+                          std::initializer_list<const char*> specs = {"sweep-sah", "Q2", "Q2+wide8", "embree-medium"}) {
+  const PrimitiveSet prims = make_primitive_set(scene);
+  for (const char* spec : specs) {
+    const Bvh bvh = run_builder(test::config_from_spec(spec), prims);
+    if (tree_arity(bvh) <= 4) {
+      const Bvh tree4 = traced_tree(bvh, Layout::Bvh4);
+      expect_packets_match_single_rays(make_wide_bvh<4>(tree4, leaf_triangles(tree4, prims, scene)), rays,
+                                       what + ", " + spec);
+    }
+    const Bvh tree8 = traced_tree(bvh, Layout::Bvh8);
+    expect_packets_match_single_rays(make_wide_bvh<8>(tree8, leaf_triangles(tree8, prims, scene)), rays,
+                                     what + ", " + spec);
+  }
+}
+
+std::vector<Ray> camera_rays(const TriangleScene& scene, size_t count) {
+  const RaySets sets = scene_ray_sets(scene, make_primitive_set(scene), count, 11);
+  std::vector<Ray> rays = sets.primary;
+  rays.insert(rays.end(), sets.shadow.begin(), sets.shadow.end());
+  rays.insert(rays.end(), sets.diffuse.begin(), sets.diffuse.end());
+  return rays;
+}
+
+TEST(PacketTraversal, DefaultSceneCameraRaysSameAsSingleRays) {
+  const TriangleScene scene = make_default_scene();
+  expect_packets_match(scene, camera_rays(scene, 6000), "default scene");
+}
+
+TEST(PacketTraversal, RandomRaysSameAsSingleRays) {  // incoherent: most packets split into single rays
+  const TriangleScene scene = test::random_triangles(3000, 41);
+  expect_packets_match(scene, test::traversal_rays(scene, 3000, 9), "random");
+  const TriangleScene clustered = test::clustered_triangles(3000, 42);
+  expect_packets_match(clustered, test::traversal_rays(clustered, 3000, 10), "clustered");
+}
+
+TEST(PacketTraversal, CoincidentTrianglesSameAsSingleRays) {
+  const TriangleScene scene = test::identical_triangles(300);
+  expect_packets_match(scene, test::traversal_rays(scene, 500, 12), "identical");
+  const TriangleScene nested = test::shared_centroid_triangles(300);
+  expect_packets_match(nested, test::traversal_rays(nested, 500, 13), "shared centroid");
+}
+
+TEST(PacketTraversal, EveryStressCaseSameAsSingleRays) {
+  for (const std::string& name : stress_case_names()) {
+    const StressCase c = make_stress_case(name, StressSizes{2000, 300});
+    if (c.scene.size() == 0) continue;
+    const PrimitiveSet prims = make_primitive_set(c.scene);
+    if (prims.size() == 0) continue;
+    std::vector<Ray> rays = test::traversal_rays(c.scene, 800, 14);
+    if (rays.size() > c.max_rays) rays.resize(c.max_rays);
+    expect_packets_match(c.scene, rays, name, {"sweep-sah", "Q2"});
+  }
+}
+
+// A partial packet (rtcIntersect16 with some lanes off) answers its valid lanes only.
+TEST(PacketTraversal, InvalidLanesAreNotTouched) {
+  const TriangleScene scene = make_default_scene();
+  const PrimitiveSet prims = make_primitive_set(scene);
+  const Bvh bvh = run_builder(test::config_from_spec("Q2"), prims);
+  const Tracer tracer(bvh, prims, scene, Layout::Bvh8);
+  const std::vector<Ray> rays = camera_rays(scene, 600);
+  std::vector<Hit> single;
+  tracer.trace(rays, Query::Closest, single);
+  Hit untouched;
+  untouched.t = -1.0f, untouched.primID = 12345;
+  for (size_t first = 0; first + kMaxPacket <= rays.size(); first += kMaxPacket) {
+    const unsigned valid = (0x9E37u * unsigned(first + 1)) & 0xFFFFu;  // lanes on and off, varying
+    std::vector<Hit> hits(kMaxPacket, untouched);
+    tracer.trace_packet(rays.data() + first, valid, Query::Closest, hits.data());
+    for (unsigned i = 0; i < kMaxPacket; ++i) {
+      const Hit& expected = valid >> i & 1 ? single[first + i] : untouched;
+      ASSERT_EQ(std::memcmp(&hits[i], &expected, sizeof(Hit)), 0) << "packet at " << first << ", lane " << i;
+    }
+  }
+  Hit hit;
+  EXPECT_THROW(tracer.trace_packet(rays.data(), 1u << kMaxPacket, Query::Closest, &hit), std::invalid_argument);
+  const Tracer bvh2(bvh, prims, scene, Layout::Bvh2);  // no packet kernel: one ray at a time, same answers
+  std::vector<Hit> hits(kMaxPacket, untouched);
+  bvh2.trace_packet(rays.data(), 0x00FFu, Query::Closest, hits.data());
+  for (unsigned i = 0; i < kMaxPacket; ++i) EXPECT_EQ(hits[i].primID, i < 8 ? single[i].primID : 12345u) << i;
+}
+
+// Deeper than any stack sized by hand: the packet and single-ray stacks follow the tree.
+TEST(PacketTraversal, ChainDeeperThanAnyFixedStack) {
+  const TriangleScene scene = test::random_triangles(3000, 43);
+  const PrimitiveSet prims = make_primitive_set(scene);
+  Bvh chain;
+  const uint32_t n = uint32_t(prims.size());
+  chain.prim_indices.resize(n);
+  for (uint32_t i = 0; i < n; ++i) chain.prim_indices[i] = i;
+  chain.nodes.resize(2 * n - 1);
+  Aabb below = prims.boxes[n - 1];
+  chain.nodes[2 * n - 2] = BvhNode::make_leaf(below, n - 1, 1);
+  for (int i = int(n) - 2; i >= 0; --i) {
+    chain.nodes[2 * i + 1] = BvhNode::make_leaf(prims.boxes[i], uint32_t(i), 1);
+    below = join(below, prims.boxes[i]);
+    chain.nodes[2 * i] = BvhNode::make_interior(below, 2 * i + 1, 2);
+  }
+  const Bvh tree = collapse_to_width(chain, 8);
+  const WideBvh<8> wide = make_wide_bvh<8>(tree, leaf_triangles(tree, prims, scene));
+  EXPECT_GE(wide.stack_size, 3000u / 7);
+  expect_packets_match_single_rays(wide, test::traversal_rays(scene, 400, 15), "chain");
+}
+
+// The point of packets, in counts that do not move with the machine: a camera's primary
+// rays read fewer nodes per ray in packets than one at a time, and test the same packs.
+TEST(PacketTraversal, CoherentRaysReadFewerNodes) {
+  const TriangleScene scene = make_default_scene();
+  const PrimitiveSet prims = make_primitive_set(scene);
+  const Bvh bvh = run_builder(test::config_from_spec("embree-medium"), prims);
+  const Tracer tracer(bvh, prims, scene, Layout::Bvh8);
+  const RaySets sets = scene_ray_sets(scene, prims, 20000, 11);
+  std::vector<Hit> hits;
+  TraversalCounters packets;
+  tracer.trace_packets(sets.primary, Query::Closest, hits, &packets);
+  const TraversalCounters single = *tracer.count(sets.primary, Query::Closest);
+  EXPECT_EQ(packets.rays, single.rays);
+  EXPECT_LT(packets.nodes * 3, single.nodes) << "packet node reads " << packets.nodes << ", single " << single.nodes;
+  std::printf("primary rays, nodes read per ray: single %.2f, packets of 16 %.2f; packs %.2f vs %.2f\n",
+              double(single.nodes) / single.rays, double(packets.nodes) / packets.rays,
+              double(single.packs) / single.rays, double(packets.packs) / packets.rays);
+}
+
+}  // namespace
+}  // namespace kmbvh
