@@ -151,11 +151,16 @@ TEST(PacketTraversal, ChainDeeperThanAnyFixedStack) {
 // The point of packets, in counts that do not move with the machine: a camera's primary
 // rays read fewer nodes per ray in packets than one at a time, and test the same packs.
 TEST(PacketTraversal, CoherentRaysReadFewerNodes) {
-  const TriangleScene scene = make_default_scene();
+  const TriangleScene scene = test::random_triangles(30000, 44);
   const PrimitiveSet prims = make_primitive_set(scene);
   const Bvh bvh = run_builder(test::config_from_spec("embree-medium"), prims);
   const Tracer tracer(bvh, prims, scene, Layout::Bvh8);
   const RaySets sets = scene_ray_sets(scene, prims, 20000, 11);
+  std::vector<Hit> single_hits;
+  tracer.trace(sets.primary, Query::Closest, single_hits);
+  size_t found = 0;
+  for (const Hit& h : single_hits) found += h.found();
+  ASSERT_GT(found, sets.primary.size() / 2) << "the camera should see the scene";
   std::vector<Hit> hits;
   TraversalCounters packets;
   tracer.trace_packets(sets.primary, Query::Closest, hits, &packets);

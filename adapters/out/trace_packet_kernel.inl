@@ -25,7 +25,9 @@ typedef int vik __attribute__((vector_size(4 * kPacketWidth)));
 // not cross a line, and these do not matter).
 typedef float vfk_unaligned __attribute__((vector_size(4 * kPacketWidth), aligned(4)));
 
+template <bool kAvx512Region = kAvx512>
 inline unsigned mask_bits(vik m) {
+  if constexpr (kAvx512Region) return _mm512_movepi32_mask(__m512i(m));
   vi8 lo, hi;
   __builtin_memcpy(&lo, &m, sizeof(lo));
   __builtin_memcpy(&hi, reinterpret_cast<const char*>(&m) + sizeof(lo), sizeof(hi));
@@ -74,6 +76,84 @@ inline float nearest_entry(vfk entry, unsigned rays) {
   return nearest;
 }
 
+// Rays in a leaf from which its packs are tested SIMD over the rays (below: each ray
+// tests the pack SIMD over its triangles, as alone).
+constexpr unsigned kRaysForPacketLeaf = 6;
+
+// The pack test's per-ray constants (PackRay), one lane a ray, and each ray's axes.
+struct PacketShear {
+  vfk org[3];      // the origin's kx, ky, kz components
+  vfk sx, sy, sz, tnear;
+  vik axis[3][2];  // axis[j][a]: the lanes whose j-th sheared axis (kx, ky, kz) is a (0 or 1; neither: 2)
+};
+
+// Component `axis` of a pack vertex, lane by lane, for each ray's axis j.
+inline vfk sheared_component(const PacketShear& r, int j, const float* x, const float* y, const float* z, int slot) {
+  return select(r.axis[j][0], splatk(x[slot]), select(r.axis[j][1], splatk(y[slot]), splatk(z[slot])));
+}
+
+// intersect_pack for the rays `active` at once, SIMD over the rays (one triangle of the
+// pack at a time), in the same operations on the same values lane by lane, so each ray
+// gets the masks and t it would get alone; then each ray's candidates are confirmed by
+// confirm_hits, as alone. Calls `found(i, slot, t, check, bound)` for each ray with a
+// candidate.
+template <Query query, Confirm confirm, typename Count, typename Found>
+__attribute__((always_inline)) inline void intersect_pack_rays(const TrianglePack& p, const PacketShear& r,
+                                                              const PackRay* pack_rays, const Ray* rays,
+                                                              const Search* search, vfk reach, unsigned active,
+                                                              Count& count, const Found& found) {
+  vik on{};
+  for (unsigned i = 0; i < kPacketWidth; ++i) on[i] = active >> i & 1 ? -1 : 0;
+  unsigned hits[kPackWidth], redo[kPackWidth], any = 0;
+  vfk ts[kPackWidth];
+  const vfk zero{};
+  for (int slot = 0; slot < kPackWidth; ++slot) {
+    vfk x[3], y[3], z[3];
+    for (int v = 0; v < 3; ++v) {
+      const vfk dx = sheared_component(r, 0, p.v[v][0], p.v[v][1], p.v[v][2], slot) - r.org[0];
+      const vfk dy = sheared_component(r, 1, p.v[v][0], p.v[v][1], p.v[v][2], slot) - r.org[1];
+      z[v] = sheared_component(r, 2, p.v[v][0], p.v[v][1], p.v[v][2], slot) - r.org[2];
+      x[v] = dx - r.sx * z[v];
+      y[v] = dy - r.sy * z[v];
+    }
+    const vfk U = x[2] * y[1] - y[2] * x[1];
+    const vfk V = x[0] * y[2] - y[0] * x[2];
+    const vfk W = x[1] * y[0] - y[1] * x[0];
+    const vik negative = (U < zero) | (V < zero) | (W < zero);
+    const vik positive = (U > zero) | (V > zero) | (W > zero);
+    const vfk det = U + V + W;
+    const vfk T = U * (r.sz * z[0]) + V * (r.sz * z[1]) + W * (r.sz * z[2]);
+    const vik sign = vik(det) & (vik{} + int(0x80000000));
+    const vfk abs_det = vfk(vik(det) ^ sign), abs_T = vfk(vik(T) ^ sign);
+    const vik valid =
+        ~(negative & positive) & (det != zero) & (abs_T > r.tnear * abs_det) & (abs_T <= reach * abs_det);
+    const vik exact_zero = (U == zero) | (V == zero) | (W == zero);
+    hits[slot] = mask_bits(valid & ~exact_zero & on);
+    redo[slot] = mask_bits(exact_zero & on);
+    any |= hits[slot] | redo[slot];
+    if (hits[slot] | redo[slot]) ts[slot] = T / det;
+  }
+  for (; any; any &= any - 1) {
+    const unsigned i = __builtin_ctz(any);
+    unsigned h = 0, z = 0;
+    vfp t{};
+    for (int slot = 0; slot < kPackWidth; ++slot) {
+      h |= (hits[slot] >> i & 1) << slot;
+      z |= (redo[slot] >> i & 1) << slot;
+      if ((hits[slot] | redo[slot]) >> i & 1) t[slot] = ts[slot][i];
+    }
+    float t_hit;
+    ExactCheck check;
+    float bound = 0.0f;
+    const int slot =
+        query == Query::Any
+            ? confirm_hits<query, confirm>(p, pack_rays[i], rays[i].tnear, search[i], t, h, z, t_hit, check, bound, count)
+            : confirm_hits_apart<query, confirm>(p, pack_rays[i], rays[i].tnear, search[i], t, h, z, t_hit, check, bound,
+                                                 count);
+    if (slot >= 0) found(i, slot, t_hit, check, bound);
+  }
+}
+
 // The rays of `valid` (bit i: rays[i]) into hits; the others' hits are left as they are.
 // `stack` holds bvh.stack_size packet entries, `single` bvh.stack_size single-ray ones.
 template <int W, Query query, typename Count>
@@ -91,22 +171,58 @@ void traverse_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Hit
   alignas(64) unsigned char pack_storage[kPacketWidth * sizeof(PackRay)];
   PackRay* pack_rays = reinterpret_cast<PackRay*>(pack_storage);
   Search search[kPacketWidth];
-  PacketRays pr;
-  vfk cull;  // each ray's Search::cull (-inf: not searching)
+  // Lane by lane into plain arrays first, then each array into its vector at once (lane
+  // inserts into vector registers cost several instructions each).
+  struct alignas(64) Lanes16 {
+    float org[3][kPacketWidth], inv[3][kPacketWidth], tnear[kPacketWidth], cull[kPacketWidth];
+    float shear_org[3][kPacketWidth], sx[kPacketWidth], sy[kPacketWidth], sz[kPacketWidth], shear_tnear[kPacketWidth];
+    int near_hi[3][kPacketWidth], axis[3][2][kPacketWidth];
+  } lanes{};
   for (unsigned i = 0; i < kPacketWidth; ++i) {
     const bool on = alive >> i & 1;
     const Ray& ray = rays[on ? i : __builtin_ctz(alive | 1)];
     const RaySetup setup(ray);
-    if (on) new (&pack_rays[i]) PackRay(ray, setup);
     for (int d = 0; d < 3; ++d) {
-      pr.org[d][i] = ray.org[d];
-      pr.inv[d][i] = setup.inv[d];
-      pr.near_hi[d][i] = setup.inv[d] < 0.0f ? -1 : 0;
+      lanes.org[d][i] = ray.org[d];
+      lanes.inv[d][i] = setup.inv[d];
+      lanes.near_hi[d][i] = setup.inv[d] < 0.0f ? -1 : 0;
     }
-    pr.tnear[i] = on ? ray.tnear : std::numeric_limits<float>::infinity();
+    lanes.tnear[i] = on ? ray.tnear : std::numeric_limits<float>::infinity();
+    lanes.cull[i] = on ? ray.tfar : -std::numeric_limits<float>::infinity();
     search[i] = Search(ray.tfar);
-    cull[i] = on ? ray.tfar : -std::numeric_limits<float>::infinity();
+    if (!on) continue;
+    const PackRay& pack_ray = *new (&pack_rays[i]) PackRay(ray, setup);
+    const RayShear& sh = pack_ray.shear;
+    const int k[3] = {sh.kx, sh.ky, sh.kz};
+    for (int j = 0; j < 3; ++j) {
+      lanes.shear_org[j][i] = ray.org[k[j]];
+      lanes.axis[j][0][i] = k[j] == 0 ? -1 : 0;
+      lanes.axis[j][1][i] = k[j] == 1 ? -1 : 0;
+    }
+    lanes.sx[i] = sh.sx, lanes.sy[i] = sh.sy, lanes.sz[i] = sh.sz;
+    lanes.shear_tnear[i] = ray.tnear;
   }
+  auto vf = [](const float* a) {
+    vfk v;
+    __builtin_memcpy(&v, a, sizeof(v));
+    return v;
+  };
+  auto vi = [](const int* a) {
+    vik v;
+    __builtin_memcpy(&v, a, sizeof(v));
+    return v;
+  };
+  PacketRays pr;
+  PacketShear shear;
+  for (int d = 0; d < 3; ++d) {
+    pr.org[d] = vf(lanes.org[d]), pr.inv[d] = vf(lanes.inv[d]), pr.near_hi[d] = vi(lanes.near_hi[d]);
+    shear.org[d] = vf(lanes.shear_org[d]);
+    shear.axis[d][0] = vi(lanes.axis[d][0]), shear.axis[d][1] = vi(lanes.axis[d][1]);
+  }
+  pr.tnear = vf(lanes.tnear);
+  shear.sx = vf(lanes.sx), shear.sy = vf(lanes.sy), shear.sz = vf(lanes.sz), shear.tnear = vf(lanes.shear_tnear);
+  vfk cull = vf(lanes.cull);  // each ray's Search::cull (-inf: not searching)
+  vfk reach = vf(lanes.cull);  // and its Search::reach (tfar while nothing is found)
   if (!alive) return;
   // The nearest candidate's hit for the rays that answer closest-hit queries, or the
   // occluder for the occlusion rays that found one.
@@ -118,7 +234,7 @@ void traverse_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Hit
                                           count))
       alive &= ~(1u << i), answered |= 1u << i, cull[i] = -std::numeric_limits<float>::infinity();
     else
-      cull[i] = search[i].cull;
+      cull[i] = search[i].cull, reach[i] = search[i].reach;
   };
   uint32_t sp = 0;
   PacketEntry cur{pr.tnear, 0, 0, alive};
@@ -159,15 +275,9 @@ void traverse_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Hit
     } else {
       for (uint32_t p = cur.ref, end = cur.ref + (cur.count + kPackWidth - 1) / kPackWidth; p < end; ++p) {
         const TrianglePack& pack = bvh.packs[p];
-        for (unsigned b = cur.rays & alive; b; b &= b - 1) {
-          const unsigned i = __builtin_ctz(b);
+        // Ray i's candidate `slot` of this pack, as the single-ray descent takes it.
+        auto take = [&](unsigned i, int slot, float t, const ExactCheck& e, float bound) {
           Search& s = search[i];
-          count.pack(std::min<uint32_t>(kPackWidth, cur.count - (p - cur.ref) * kPackWidth));
-          float t;
-          ExactCheck e;
-          float bound = 0.0f;
-          const int slot = intersect_pack<query, confirm>(pack, pack_rays[i], rays[i].tnear, s, t, e, bound, count);
-          if (slot < 0) continue;
           s.found = p * kPackWidth + uint32_t(slot);
           s.found_key = tie_key(pack.id[slot]);
           s.check = e;
@@ -179,7 +289,24 @@ void traverse_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Hit
           } else {
             s.narrow(t);
             cull[i] = s.cull;
+            reach[i] = s.reach;
           }
+        };
+        const unsigned in = cur.rays & alive;
+        const uint32_t triangles = std::min<uint32_t>(kPackWidth, cur.count - (p - cur.ref) * kPackWidth);
+        for (unsigned b = in; b; b &= b - 1) count.pack(triangles);
+        if (unsigned(__builtin_popcount(in)) >= kRaysForPacketLeaf) {
+          intersect_pack_rays<query, confirm>(pack, shear, pack_rays, rays, search, reach, in, count, take);
+          continue;
+        }
+        for (unsigned b = in; b; b &= b - 1) {
+          const unsigned i = __builtin_ctz(b);
+          float t;
+          ExactCheck e;
+          float bound = 0.0f;
+          const int slot =
+              intersect_pack<query, confirm>(pack, pack_rays[i], rays[i].tnear, search[i], t, e, bound, count);
+          if (slot >= 0) take(i, slot, t, e, bound);
         }
       }
     }

@@ -40,6 +40,7 @@ TraversalCounters& TraversalCounters::operator+=(const TraversalCounters& o) {
 
 namespace wide_sse42 {
 constexpr bool kAvx = false;
+constexpr bool kAvx512 = false;
 namespace {
 #include "trace_wide_kernel.inl"
 #include "trace_packet_kernel.inl"
@@ -49,6 +50,7 @@ namespace {
 KMBVH_TARGET_BEGIN("popcnt,avx,avx2,fma,bmi,bmi2")
 namespace wide_avx2 {
 constexpr bool kAvx = true;
+constexpr bool kAvx512 = false;
 namespace {
 #include "trace_wide_kernel.inl"
 #include "trace_packet_kernel.inl"
@@ -59,6 +61,7 @@ KMBVH_TARGET_END
 KMBVH_TARGET_BEGIN("popcnt,avx,avx2,fma,bmi,bmi2,avx512f,avx512vl,avx512bw,avx512dq,avx512cd")
 namespace wide_avx512 {
 constexpr bool kAvx = true;
+constexpr bool kAvx512 = true;
 namespace {
 #include "trace_wide_kernel.inl"
 #include "trace_packet_kernel.inl"
