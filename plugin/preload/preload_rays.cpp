@@ -9,6 +9,7 @@
 // geometry kmbvh answers for has the default mask). Packet lanes are active where valid
 // is -1.
 #include <algorithm>
+#include <limits>
 #include <optional>
 
 #include "ab_mode.h"
@@ -88,24 +89,63 @@ void answer_rays(const SceneAccel& accel, RTCScene scene, Query query, RTCInters
   }
 }
 
-// A 4-, 8- or 16-wide packet: RTCRayHitK is {RTCRayK ray; RTCHitK hit;}, both SoA.
+// A 4-, 8- or 16-wide packet (RTCRayHitK is {RTCRayK ray; RTCHitK hit;}, both SoA), read
+// into the kernel's rays and written back lane by lane with no RayRef in between (its
+// pointers cost as much as the packet's traversal). Where answer_rays would answer one
+// ray at a time (filters, the A/B mode), it does.
+template <unsigned K>
+void answer_packet(const SceneAccel& accel, RTCScene scene, const int* valid, RTCRayN* r, RTCHitN* h, Query query,
+                   RTCIntersectContext* context, QueryForm form) {
+  if (ab_mode_on() || accel.has_filters(query)) {
+    answer_rays(accel, scene, query, context, form, K, [&](unsigned i) -> std::optional<RayRef> {
+      if (valid[i] != -1) return std::nullopt;
+      return lane_ref(r, h, K, i);
+    });
+    return;
+  }
+  Ray rays[K];
+  Hit hits[K];
+  unsigned on = 0;
+  for (unsigned i = 0; i < K; ++i) {
+    if (valid[i] != -1 || RTCRayN_mask(r, K, i) == 0) continue;  // mask 0 hits nothing (SceneAccel::trace)
+    rays[i].org = Vec3(RTCRayN_org_x(r, K, i), RTCRayN_org_y(r, K, i), RTCRayN_org_z(r, K, i));
+    rays[i].dir = Vec3(RTCRayN_dir_x(r, K, i), RTCRayN_dir_y(r, K, i), RTCRayN_dir_z(r, K, i));
+    rays[i].tnear = RTCRayN_tnear(r, K, i);
+    rays[i].tfar = RTCRayN_tfar(r, K, i);
+    on |= 1u << i;
+  }
+  if (!on) return;
+  accel.trace_packet(rays, on, query, hits);
+  const unsigned inst_id = context_inst_id(context);
+  for (; on; on &= on - 1) {  // as write_answer
+    const unsigned i = __builtin_ctz(on);
+    const Hit& hit = hits[i];
+    if (!hit.found()) continue;
+    float& tfar = RTCRayN_tfar(r, K, i);
+    if (query == Query::Any) {
+      tfar = -std::numeric_limits<float>::infinity();
+      continue;
+    }
+    tfar = hit.t < tfar ? hit.t : tfar;
+    RTCHitN_Ng_x(h, K, i) = hit.Ng.x, RTCHitN_Ng_y(h, K, i) = hit.Ng.y, RTCHitN_Ng_z(h, K, i) = hit.Ng.z;
+    RTCHitN_u(h, K, i) = hit.u, RTCHitN_v(h, K, i) = hit.v;
+    RTCHitN_primID(h, K, i) = hit.primID, RTCHitN_geomID(h, K, i) = hit.geomID;
+    RTCHitN_instID(h, K, i, 0) = inst_id;
+  }
+}
+
 template <unsigned N, typename RayHitK>
 void intersect_packet(const SceneAccel& accel, RTCScene scene, const int* valid, RayHitK* rh,
                       RTCIntersectContext* context, QueryForm form) {
-  answer_rays(accel, scene, Query::Closest, context, form, N, [&](unsigned i) -> std::optional<RayRef> {
-    if (valid[i] != -1) return std::nullopt;
-    return lane_ref(&rh->ray, &rh->hit, N, i);
-  });
+  answer_packet<N>(accel, scene, valid, reinterpret_cast<RTCRayN*>(&rh->ray), reinterpret_cast<RTCHitN*>(&rh->hit),
+                   Query::Closest, context, form);
   count_kmbvh_rays(count_valid(valid, N));
 }
 
 template <unsigned N, typename RayK>
 void occluded_packet(const SceneAccel& accel, RTCScene scene, const int* valid, RayK* r, RTCIntersectContext* context,
                      QueryForm form) {
-  answer_rays(accel, scene, Query::Any, context, form, N, [&](unsigned i) -> std::optional<RayRef> {
-    if (valid[i] != -1) return std::nullopt;
-    return lane_ref(r, nullptr, N, i);
-  });
+  answer_packet<N>(accel, scene, valid, reinterpret_cast<RTCRayN*>(r), nullptr, Query::Any, context, form);
   count_kmbvh_rays(count_valid(valid, N));
 }
 

@@ -9,7 +9,12 @@
 //
 //   scene_client trace SCENE OUT.bin [--filter] [--quad]   (SCENE: a file, or "default")
 //   scene_client compare SCENE REFERENCE.bin TEST.bin [--filter] [--exact-forms]
+//   scene_client time SCENE RUNS   (scripts/bench_packets_preload.sh)
 //
+// `time` prints the Mrays/s of rtcIntersect1 and rtcIntersect16 on the scene's primary
+// rays, and of rtcOccluded1 and rtcOccluded16 on its shadow rays (100,000 of each, one
+// thread, the median of RUNS runs): run alone and under the preload, the same calls
+// measure Embree and kmbvh.
 // --filter: mesh 1 gets intersect and occluded filter functions that refuse odd primIDs.
 // --quad:   an enabled quad mesh is attached too, which kmbvh does not answer (fallback).
 #include <embree3/rtcore.h>
@@ -17,6 +22,7 @@
 
 #include <algorithm>
 #include <atomic>
+#include <chrono>
 #include <cmath>
 #include <cstdio>
 #include <cstring>
@@ -346,6 +352,62 @@ int trace(const Options& o, const std::string& out) {
   return 0;
 }
 
+// The median seconds of `runs` calls of `f`, each after `prepare` (untimed).
+template <typename Prepare, typename F>
+double median_seconds(int runs, const Prepare& prepare, const F& f) {
+  std::vector<double> t;
+  for (int i = 0; i < runs; ++i) {
+    prepare();
+    const auto start = std::chrono::steady_clock::now();
+    f();
+    t.push_back(std::chrono::duration<double>(std::chrono::steady_clock::now() - start).count());
+  }
+  std::sort(t.begin(), t.end());
+  return t[t.size() / 2];
+}
+
+int time_forms(const Options& o, int runs) {
+  const TriangleScene scene = load(o.scene);
+  const RaySets sets = scene_ray_sets(scene, make_primitive_set(scene), 100000, kSeed);
+  RTCDevice device = rtcNewDevice(nullptr);
+  std::vector<std::vector<char>> keep;
+  RTCScene s = build_scene(device, scene, o, keep);
+  RTCIntersectContext c;
+  rtcInitIntersectContext(&c);
+  for (const RayKind kind : {RayKind::Primary, RayKind::Shadow}) {
+    const std::vector<Ray>& rays = sets.of(kind);
+    const size_t n = rays.size(), packets = (n + 15) / 16;
+    std::vector<RTCRayHit> single(n), single_in(n);
+    for (size_t i = 0; i < n; ++i) put_ray(single_in[i].ray, rays[i], ~0u), clear_hit(single_in[i].hit);
+    std::vector<RTCRayHit16> packet(packets), packet_in(packets);
+    struct alignas(64) Valid16 {  // Embree reads a packet's valid mask as one aligned vector
+      int lane[16];
+    };
+    std::vector<Valid16> valid(packets);
+    for (size_t p = 0; p < packets; ++p)
+      for (size_t i = 0; i < 16; ++i) {
+        const size_t at = p * 16 + i;
+        valid[p].lane[i] = at < n ? -1 : 0;
+        put_ray(packet_in[p].ray, i, at < n ? rays[at] : Ray{}, ~0u);
+        packet_in[p].hit.geomID[i] = RTC_INVALID_GEOMETRY_ID;
+      }
+    const bool shadow = kind == RayKind::Shadow;
+    const double one = median_seconds(runs, [&] { single = single_in; }, [&] {
+      for (size_t i = 0; i < n; ++i) shadow ? rtcOccluded1(s, &c, &single[i].ray) : rtcIntersect1(s, &c, &single[i]);
+    });
+    const double sixteen = median_seconds(runs, [&] { packet = packet_in; }, [&] {
+      for (size_t p = 0; p < packets; ++p)
+        shadow ? rtcOccluded16(valid[p].lane, s, &c, &packet[p].ray) : rtcIntersect16(valid[p].lane, s, &c, &packet[p]);
+    });
+    std::printf("%s %zu rays: %s1 %.2f Mrays/s, %s16 %.2f Mrays/s\n", to_string(kind), n,
+                shadow ? "rtcOccluded" : "rtcIntersect", n / one * 1e-6, shadow ? "rtcOccluded" : "rtcIntersect",
+                n / sixteen * 1e-6);
+  }
+  rtcReleaseScene(s);
+  rtcReleaseDevice(device);
+  return 0;
+}
+
 // The scene the answers can be checked against: the triangles a hit may land on (with
 // --filter, the refused ones are left out), indexed by (geomID, primID).
 struct CheckScene {
@@ -447,7 +509,8 @@ int compare(const Options& o, const std::string& ref_path, const std::string& te
 
 int main(int argc, char** argv) {
   try {
-    if (argc < 4) throw std::invalid_argument("usage: scene_client trace SCENE OUT | compare SCENE REF TEST [options]");
+    if (argc < 4)
+      throw std::invalid_argument("usage: scene_client trace SCENE OUT | compare SCENE REF TEST | time SCENE RUNS [options]");
     const std::string mode = argv[1];
     Options o;
     o.scene = argv[2];
@@ -462,6 +525,7 @@ int main(int argc, char** argv) {
     }
     if (mode == "trace" && files.size() == 1) return trace(o, files[0]);
     if (mode == "compare" && files.size() == 2) return compare(o, files[0], files[1]);
+    if (mode == "time" && files.size() == 1) return time_forms(o, std::max(1, std::atoi(files[0].c_str())));
     throw std::invalid_argument("bad arguments");
   } catch (const std::exception& e) {
     std::fprintf(stderr, "scene_client: %s\n", e.what());
