@@ -36,6 +36,13 @@ inline unsigned mask_bits(vik m) {
 
 inline vfk splatk(float x) { return vfk{x, x, x, x, x, x, x, x, x, x, x, x, x, x, x, x}; }
 
+// Bit i of `bits` as lane i of a mask.
+inline vik lanes_of(unsigned bits) {
+  const vik bit{1 << 0, 1 << 1, 1 << 2,  1 << 3,  1 << 4,  1 << 5,  1 << 6,  1 << 7,
+                1 << 8, 1 << 9, 1 << 10, 1 << 11, 1 << 12, 1 << 13, 1 << 14, 1 << 15};
+  return (bit & int(bits)) != 0;
+}
+
 // a where mask is set, b elsewhere.
 inline vfk select(vik mask, vfk a, vfk b) { return vfk((vik(a) & mask) | (vik(b) & ~mask)); }
 
@@ -70,10 +77,12 @@ struct PacketEntry {
 
 // The nearest entry among the rays `rays` (for ordering children: the packet goes first
 // where its nearest ray goes first).
-inline float nearest_entry(vfk entry, unsigned rays) {
-  float nearest = std::numeric_limits<float>::infinity();
-  for (; rays; rays &= rays - 1) nearest = std::min(nearest, entry[__builtin_ctz(rays)]);
-  return nearest;
+inline float nearest_entry(vfk entry, vik rays) {
+  const vfk v = select(rays, entry, splatk(std::numeric_limits<float>::infinity()));
+  const vf8 a = vmin(__builtin_shufflevector(v, v, 0, 1, 2, 3, 4, 5, 6, 7),
+                     __builtin_shufflevector(v, v, 8, 9, 10, 11, 12, 13, 14, 15));
+  const vf4 b = vmin(__builtin_shufflevector(a, a, 0, 1, 2, 3), __builtin_shufflevector(a, a, 4, 5, 6, 7));
+  return std::min(std::min(b[0], b[1]), std::min(b[2], b[3]));
 }
 
 // Rays in a leaf from which its packs are tested SIMD over the rays (below: each ray
@@ -102,8 +111,7 @@ __attribute__((always_inline)) inline void intersect_pack_rays(const TrianglePac
                                                               const PackRay* pack_rays, const Ray* rays,
                                                               const Search* search, vfk reach, unsigned active,
                                                               Count& count, const Found& found) {
-  vik on{};
-  for (unsigned i = 0; i < kPacketWidth; ++i) on[i] = active >> i & 1 ? -1 : 0;
+  const vik on = lanes_of(active);
   unsigned hits[kPackWidth], redo[kPackWidth], any = 0;
   vfk ts[kPackWidth];
   const vfk zero{};
@@ -248,28 +256,28 @@ void traverse_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Hit
       const WideNode<W>& n = bvh.nodes[cur.ref];
       count.node();
       _mm_prefetch(reinterpret_cast<const char*>(n.ref), _MM_HINT_T0);
-      vik active{};
-      for (unsigned i = 0; i < kPacketWidth; ++i) active[i] = cur.rays >> i & 1 ? -1 : 0;
+      const vik active = lanes_of(cur.rays);
       PacketEntry entered[W];
       float nearest[W];
+      int order[W];  // entered children, farthest first (for occlusion: as met)
       int m = 0;
-      for (int c = 0; c < W; ++c) {
+      // Lanes holding a child: an empty lane's box is inverted (wide_bvh.h).
+      for (unsigned lanes = mask_bits(load<W>(n.lo[0]) <= load<W>(n.hi[0])); lanes; lanes &= lanes - 1) {
+        const int c = __builtin_ctz(lanes);
         vfk entry;
-        const unsigned in = mask_bits(enter_child(n, c, pr, cull, active, entry));
-        if (!in) continue;
-        entered[m] = PacketEntry{entry, n.ref[c], n.count[c], in};
+        const vik in = enter_child(n, c, pr, cull, active, entry);
+        const unsigned rays_in = mask_bits(in);
+        if (!rays_in) continue;
+        entered[m] = PacketEntry{entry, n.ref[c], n.count[c], rays_in};
         prefetch_child(bvh, n.ref[c], n.count[c]);
-        // Ordered by the nearest ray's entry, farthest pushed first (for occlusion: as met).
         nearest[m] = query == Query::Any ? 0.0f : nearest_entry(entry, in);
-        int at = m++;
-        for (; at > 0 && nearest[at - 1] < nearest[at]; --at) {
-          std::swap(entered[at - 1], entered[at]);
-          std::swap(nearest[at - 1], nearest[at]);
-        }
+        int at = m;
+        for (; at > 0 && nearest[order[at - 1]] < nearest[m]; --at) order[at] = order[at - 1];
+        order[at] = m++;
       }
       if (m > 0) {
-        for (int i = 0; i < m - 1; ++i) stack[sp++] = entered[i];
-        cur = entered[m - 1];
+        for (int i = 0; i < m - 1; ++i) stack[sp++] = entered[order[i]];
+        cur = entered[order[m - 1]];
         continue;
       }
     } else {
