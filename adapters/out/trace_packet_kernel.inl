@@ -155,9 +155,10 @@ __attribute__((always_inline)) inline void intersect_pack_rays(const TrianglePac
     float bound = 0.0f;
     const int slot =
         query == Query::Any
-            ? confirm_hits<query, confirm>(p, pack_rays[i], rays[i].tnear, search[i], t, h, z, t_hit, check, bound, count)
-            : confirm_hits_apart<query, confirm>(p, pack_rays[i], rays[i].tnear, search[i], t, h, z, t_hit, check, bound,
-                                                 count);
+            ? confirm_hits<query, confirm>(p, pack_rays[i], rays[i].tnear, search[i].tmax, search[i].reach,
+                                           search[i].found_key, t, h, z, t_hit, check, bound, count)
+            : confirm_hits_apart<query, confirm>(p, pack_rays[i], rays[i].tnear, search[i].tmax, search[i].reach,
+                                                 search[i].found_key, t, h, z, t_hit, check, bound, count);
     if (slot >= 0) found(i, slot, t_hit, check, bound);
   }
 }

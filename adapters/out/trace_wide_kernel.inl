@@ -1,6 +1,6 @@
 // The wide traversal's kernel: included by trace_wide.cpp once per instruction set, each
-// time inside its own namespace and `#pragma GCC target` region, with kAvx defined (whether
-// the region has AVX). Everything here is compiled for that region's instruction set;
+// time inside its own namespace and `#pragma GCC target` region, with kAvx and kAvx512
+// defined (whether the region has AVX, AVX-512). Everything here is compiled for that region's instruction set;
 // what it calls from outside (watertight.h, the standard library) is compiled for the
 // file's and inlined, which a wider instruction set allows.
 //
@@ -193,18 +193,24 @@ enum class Confirm { Exact, Interval, Deferred };
 // duplicated in place) does not depend on the order the traversal meets them in: the
 // packet traversal meets them in another order than a single ray does.
 inline uint64_t tie_key(PrimitiveId id) { return uint64_t(id.geom) << 32 | id.prim; }
+constexpr uint64_t kNoCandidate = ~uint64_t(0);  // no triangle has kInvalidId for both ids
 
 // How far past the closest candidate's t the pack test looks once there is one: a triangle
 // at the very same t then passes its scaled interval test (|T| <= tmax |det|) whatever the
-// roundings (8 ulp), and the order is decided on the candidates' t and ids.
-inline float tie_reach(float t) { return t + std::fabs(t) * 0x1p-21f; }
+// roundings (2^-21 of t, 4 to 8 ulp), and the order is decided on the candidates' t and ids.
+inline float tie_reach(float t) { return t * (1.0f + 0x1p-21f); }  // t > tnear >= 0 (ray_is_valid)
 
 // The boxes a ray enters once it has a candidate at t: those it enters before t, and a
 // little beyond (2^-14 of t). A triangle's float t is off by a few ulp, and on large
 // triangles far from the origin by more; a coincident triangle at the same exact t whose
 // box the ray enters just after the candidate's float t must still be met, or which of the
-// two is the closest hit would depend on which the traversal met first (tie_key).
-inline float cull_reach(float t) { return t + std::fabs(t) * 0x1p-14f; }
+// two is the closest hit would depend on which the traversal met first (tie_key). (One
+// multiplication each, so a new candidate delays the next box test the least.)
+inline float cull_reach(float t) { return t * (1.0f + 0x1p-14f); }
+// A stack entry is popped up to cull_reach(t) * kRobustExit, the box test's reach (at
+// least: the constant rounds up), in one multiplication off the ray's critical path.
+constexpr float kPopReach = 1.0f + 0x1p-14f + 0x1p-19f;
+static_assert(kPopReach >= (1.0f + 0x1p-14f) * kRobustExit, "a popped entry must reach as far as the box test");
 
 // A ray's search as it stands, carried from one descent to the next (the packet traversal
 // hands it to the single-ray descent and back).
@@ -212,18 +218,20 @@ struct Search {
   float tmax;                   // the interval's end: tfar, then the closest candidate's t
   float reach;                  // how far the pack test looks: tmax, then tie_reach(tmax)
   float cull;                   // how far the box tests look: tmax, then cull_reach(tmax)
+  float pop;                    // and a stack entry: cull widened as the box test widens exits
   uint32_t found = kInvalidId;  // the closest candidate's triangle
-  uint64_t found_key = 0;       // and its tie_key
+  uint64_t found_key = kNoCandidate;  // and its tie_key
   ExactCheck check;             // and its exact check (Confirm::Exact)
   float found_bound = 0.0f;     // or the end of the interval it was accepted in (Confirm::Deferred)
 
-  explicit Search(float tfar) : tmax(tfar), reach(tfar), cull(tfar) {}
+  explicit Search(float tfar) : tmax(tfar), reach(tfar), cull(tfar), pop(tfar * kRobustExit) {}
   Search() = default;
   // A closer candidate was found at t.
   void narrow(float t) {
     tmax = t;
     reach = tie_reach(t);
     cull = cull_reach(t);
+    pop = t * kPopReach;
   }
 };
 
@@ -235,17 +243,17 @@ struct Search {
 // slot's t), for its check.
 template <Query query, Confirm confirm, typename Count>
 __attribute__((always_inline)) inline int confirm_hits(const TrianglePack& p, const PackRay& r, float tnear,
-                                                       const Search& search, vfp t, unsigned hits, unsigned redo,
-                                                       float& t_hit, ExactCheck& check, float& bound, Count& count) {
+                                                       float tmax, float reach, uint64_t prior_key, vfp t,
+                                                       unsigned hits, unsigned redo, float& t_hit, ExactCheck& check,
+                                                       float& bound, Count& count) {
   auto vertex = [&](int v, int slot) { return slot_vertex(p, v, uint32_t(slot)); };
-  const float tmax = search.tmax;
-  const bool prior = search.found != kInvalidId;
+  const bool prior = prior_key != kNoCandidate;
   int best = -1;
   auto beats = [&](int slot, float ts) {
     if (best < 0 && !prior) return true;  // the test admitted it within (tnear, tfar]
     const float tb = best < 0 ? tmax : t_hit;
     if (ts != tb) return ts < tb;
-    return tie_key(p.id[slot]) < (best < 0 ? search.found_key : tie_key(p.id[best]));
+    return tie_key(p.id[slot]) < (best < 0 ? prior_key : tie_key(p.id[best]));
   };
   // Whether `slot` counts; for Exact and Interval, measured against (tnear, end]: tfar for
   // the first candidate, then a little past the closest one's float t (cull_reach), which
@@ -275,8 +283,8 @@ __attribute__((always_inline)) inline int confirm_hits(const TrianglePack& p, co
   for (; redo; redo &= redo - 1) {
     const int slot = __builtin_ctz(redo);
     Hit h;
-    const float reach = best < 0 ? search.reach : tie_reach(t_hit);
-    if (!intersect_watertight(r.shear, tnear, reach, vertex(0, slot), vertex(1, slot), vertex(2, slot), h)) continue;
+    const float end = best < 0 ? reach : tie_reach(t_hit);
+    if (!intersect_watertight(r.shear, tnear, end, vertex(0, slot), vertex(1, slot), vertex(2, slot), h)) continue;
     if (!beats(slot, h.t)) continue;
     if (!accept(slot)) continue;
     best = slot, t_hit = h.t;
@@ -289,10 +297,10 @@ __attribute__((always_inline)) inline int confirm_hits(const TrianglePack& p, co
 // keeps its registers; inline for occlusion, whose first confirmed hit ends the ray (the
 // faster of the two for each, measured).
 template <Query query, Confirm confirm, typename Count>
-__attribute__((noinline)) int confirm_hits_apart(const TrianglePack& p, const PackRay& r, float tnear,
-                                                 const Search& search, vfp t, unsigned hits, unsigned redo,
+__attribute__((noinline)) int confirm_hits_apart(const TrianglePack& p, const PackRay& r, float tnear, float tmax,
+                                                 float reach, uint64_t prior_key, vfp t, unsigned hits, unsigned redo,
                                                  float& t_hit, ExactCheck& check, float& bound, Count& count) {
-  return confirm_hits<query, confirm>(p, r, tnear, search, t, hits, redo, t_hit, check, bound, count);
+  return confirm_hits<query, confirm>(p, r, tnear, tmax, reach, prior_key, t, hits, redo, t_hit, check, bound, count);
 }
 
 // The watertight test (cuda/traversal/watertight.h) on a pack of triangles at once, in the
@@ -332,9 +340,11 @@ __attribute__((always_inline)) inline int intersect_pack(const TrianglePack& p, 
   const unsigned redo = mask_bits(exact_zero) & ~skip;
   if (!(hits | redo)) return -1;
   if constexpr (query == Query::Any)
-    return confirm_hits<query, confirm>(p, r, tnear, search, T / det, hits, redo, t_hit, check, bound, count);
+    return confirm_hits<query, confirm>(p, r, tnear, search.tmax, search.reach, search.found_key, T / det, hits, redo,
+                                        t_hit, check, bound, count);
   else
-    return confirm_hits_apart<query, confirm>(p, r, tnear, search, T / det, hits, redo, t_hit, check, bound, count);
+    return confirm_hits_apart<query, confirm>(p, r, tnear, search.tmax, search.reach, search.found_key, T / det, hits,
+                                              redo, t_hit, check, bound, count);
 }
 
 // Completes the hit on triangle `found` (hit.t is set): its ids, and unless `refine` is
@@ -477,7 +487,7 @@ __attribute__((always_inline)) inline bool descend(const WideBvh<W>& bvh, const 
     do {
       if (sp == 0) return false;
       cur = stack[--sp];
-    } while (cur.entry > s.cull * kRobustExit);  // with the box test's margin, as enter_children
+    } while (cur.entry > s.pop);
   }
 }
 
