@@ -134,6 +134,22 @@ void answer_packet(const SceneAccel& accel, RTCScene scene, const int* valid, RT
   }
 }
 
+// One SoA packet of a stream (rtcIntersectNM, rtcOccludedNM), every lane active: Embree's
+// packet widths as packets, any other width through answer_rays.
+void answer_stream_packet(const SceneAccel& accel, RTCScene scene, void* rays, void* hits, unsigned n, Query query,
+                          RTCIntersectContext* context, QueryForm form) {
+  static const int kAllValid[kMaxPacket] = {-1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1, -1};
+  auto* r = static_cast<RTCRayN*>(rays);
+  auto* h = static_cast<RTCHitN*>(hits);
+  switch (n) {
+    case 4: return answer_packet<4>(accel, scene, kAllValid, r, h, query, context, form);
+    case 8: return answer_packet<8>(accel, scene, kAllValid, r, h, query, context, form);
+    case 16: return answer_packet<16>(accel, scene, kAllValid, r, h, query, context, form);
+  }
+  answer_rays(accel, scene, query, context, form, n,
+              [&](unsigned i) -> std::optional<RayRef> { return lane_ref(rays, hits, n, i); });
+}
+
 template <unsigned N, typename RayHitK>
 void intersect_packet(const SceneAccel& accel, RTCScene scene, const int* valid, RayHitK* rh,
                       RTCIntersectContext* context, QueryForm form) {
@@ -253,8 +269,7 @@ KMBVH_EXPORT void rtcIntersectNM(RTCScene scene, RTCIntersectContext* context, R
       auto* packet = reinterpret_cast<RTCRayHitN*>(reinterpret_cast<char*>(rayhit) + m * byteStride);
       void* rays = RTCRayHitN_RayN(packet, N);
       void* hits = RTCRayHitN_HitN(packet, N);
-      answer_rays(*accel, scene, Query::Closest, context, QueryForm::IntersectNM, N,
-                  [&](unsigned i) -> std::optional<RayRef> { return lane_ref(rays, hits, N, i); });
+      answer_stream_packet(*accel, scene, rays, hits, N, Query::Closest, context, QueryForm::IntersectNM);
     }
     return count_kmbvh_rays(uint64_t(N) * M);
   }
@@ -267,8 +282,7 @@ KMBVH_EXPORT void rtcOccludedNM(RTCScene scene, RTCIntersectContext* context, RT
   if (const SceneAccel* accel = ray ? accel_for(scene, context) : nullptr) {
     for (unsigned m = 0; m < M; ++m) {
       void* rays = reinterpret_cast<char*>(ray) + m * byteStride;
-      answer_rays(*accel, scene, Query::Any, context, QueryForm::OccludedNM, N,
-                  [&](unsigned i) -> std::optional<RayRef> { return lane_ref(rays, nullptr, N, i); });
+      answer_stream_packet(*accel, scene, rays, nullptr, N, Query::Any, context, QueryForm::OccludedNM);
     }
     return count_kmbvh_rays(uint64_t(N) * M);
   }
