@@ -1,6 +1,7 @@
 #include "scene_accel.h"
 
 #include <chrono>
+#include <new>
 
 #include "adapters/builder_registry.h"
 #include "adapters/out/cpu_isa.h"
@@ -49,6 +50,16 @@ bool SceneAccel::offer(void* user, const Ray&, const Hit& offered) {
   args.N = 1;
   filter(&args);
   return valid != 0;
+}
+
+void SceneAccel::trace_packet(const Ray* rays, unsigned valid, Query query, Hit* hits) const {
+  if (!tracer_) return;
+  try {
+    return tracer_->trace_packet(rays, valid, query, hits);
+  } catch (const std::bad_alloc&) {
+    // The thread's packet stacks could not be allocated: one ray at a time, on the C++ stack.
+  }
+  for (; valid; valid &= valid - 1) tracer_->trace_one(rays[__builtin_ctz(valid)], query, hits[__builtin_ctz(valid)]);
 }
 
 bool SceneAccel::trace_filtered(const Ray& ray, const RTCRay& app_ray, unsigned ray_mask, Query query,

@@ -81,9 +81,7 @@ class SceneAccel {
 
   // Up to 16 rays at once, as trace() answers each (Tracer::trace_packet): bit i of `valid`
   // traces rays[i] into hits[i]. Rays of mask 0 are left out of `valid` by the caller.
-  void trace_packet(const Ray* rays, unsigned valid, Query query, Hit* hits) const {
-    if (tracer_) tracer_->trace_packet(rays, valid, query, hits);
-  }
+  void trace_packet(const Ray* rays, unsigned valid, Query query, Hit* hits) const;
 
   // The triangles, under KMBVH_AB only (null otherwise).
   const AccelGeometry* geometry() const { return geometry_.get(); }
