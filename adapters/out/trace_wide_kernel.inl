@@ -303,6 +303,36 @@ __attribute__((noinline)) int confirm_hits_apart(const TrianglePack& p, const Pa
   return confirm_hits<query, confirm>(p, r, tnear, tmax, reach, prior_key, t, hits, redo, t_hit, check, bound, count);
 }
 
+// The watertight test's decision, lane by lane, from the vertices sheared into the ray's
+// frame (x, y and z relative to the origin, z not yet scaled by sz), in the scalar test's
+// operations: `valid`, the lanes hit within (tnear, reach] (|T| against |det| times the
+// interval's ends); `exact_zero`, the lanes whose edge functions came out exactly zero
+// (for the double-precision redo); t = T / det. VF, VM: float lanes and their masks, four
+// triangles of a pack for one ray (intersect_pack) or one triangle for 16 rays (the
+// packet traversal), so both give every ray the same bits.
+template <typename VF, typename VM>
+struct WatertightLanes {
+  VM valid, exact_zero;
+  VF T, det;
+};
+template <typename VF, typename VM>
+__attribute__((always_inline)) inline WatertightLanes<VF, VM> watertight_lanes(const VF (&x)[3], const VF (&y)[3],
+                                                                                const VF (&z)[3], VF sz, VF tnear,
+                                                                                VF reach) {
+  const VF U = x[2] * y[1] - y[2] * x[1];
+  const VF V = x[0] * y[2] - y[0] * x[2];
+  const VF W = x[1] * y[0] - y[1] * x[0];
+  const VF zero{};
+  const VM negative = (U < zero) | (V < zero) | (W < zero);
+  const VM positive = (U > zero) | (V > zero) | (W > zero);
+  const VF det = U + V + W;
+  const VF T = U * (sz * z[0]) + V * (sz * z[1]) + W * (sz * z[2]);
+  const VM sign = VM(det) & (VM{} + int(0x80000000));
+  const VF abs_det = VF(VM(det) ^ sign), abs_T = VF(VM(T) ^ sign);
+  return {~(negative & positive) & (det != zero) & (abs_T > tnear * abs_det) & (abs_T <= reach * abs_det),
+          (U == zero) | (V == zero) | (W == zero), T, det};
+}
+
 // The watertight test (cuda/traversal/watertight.h) on a pack of triangles at once, in the
 // same operations as the scalar test. Returns the slot of the nearest hit in (tnear,
 // search.tmax] that beats the search's candidate (confirm_hits), its float t and its exact
@@ -323,28 +353,16 @@ __attribute__((always_inline)) inline int intersect_pack(const TrianglePack& p, 
     x[v] = dx - r.sx * z[v];
     y[v] = dy - r.sy * z[v];
   }
-  const vfp U = x[2] * y[1] - y[2] * x[1];
-  const vfp V = x[0] * y[2] - y[0] * x[2];
-  const vfp W = x[1] * y[0] - y[1] * x[0];
-  const vfp zero{};
-  const vip negative = (U < zero) | (V < zero) | (W < zero);
-  const vip positive = (U > zero) | (V > zero) | (W > zero);
-  const vfp det = U + V + W;
-  const vfp T = U * (r.sz * z[0]) + V * (r.sz * z[1]) + W * (r.sz * z[2]);
-  const vip sign = vip(det) & (vip{} + int(0x80000000));
-  const vfp abs_det = vfp(vip(det) ^ sign), abs_T = vfp(vip(T) ^ sign);
-  const vip valid =
-      ~(negative & positive) & (det != zero) & (abs_T > r.tnear * abs_det) & (abs_T <= splat<vfp>(search.reach) * abs_det);
-  const vip exact_zero = (U == zero) | (V == zero) | (W == zero);
-  const unsigned hits = mask_bits(valid & ~exact_zero) & ~skip;
-  const unsigned redo = mask_bits(exact_zero) & ~skip;
+  const WatertightLanes<vfp, vip> w = watertight_lanes<vfp, vip>(x, y, z, r.sz, r.tnear, splat<vfp>(search.reach));
+  const unsigned hits = mask_bits(w.valid & ~w.exact_zero) & ~skip;
+  const unsigned redo = mask_bits(w.exact_zero) & ~skip;
   if (!(hits | redo)) return -1;
   if constexpr (query == Query::Any)
-    return confirm_hits<query, confirm>(p, r, tnear, search.tmax, search.reach, search.found_key, T / det, hits, redo,
-                                        t_hit, check, bound, count);
+    return confirm_hits<query, confirm>(p, r, tnear, search.tmax, search.reach, search.found_key, w.T / w.det, hits,
+                                        redo, t_hit, check, bound, count);
   else
-    return confirm_hits_apart<query, confirm>(p, r, tnear, search.tmax, search.reach, search.found_key, T / det, hits,
-                                              redo, t_hit, check, bound, count);
+    return confirm_hits_apart<query, confirm>(p, r, tnear, search.tmax, search.reach, search.found_key, w.T / w.det,
+                                              hits, redo, t_hit, check, bound, count);
 }
 
 // Completes the hit on triangle `found` (hit.t is set): its ids, and unless `refine` is
