@@ -121,7 +121,9 @@ void trace_wide(const WideBvh<W>& bvh, const Ray* rays, size_t n, Query query, H
   trace_wide(bvh, rays, n, query, hits, counters, traversal_isa());
 }
 
-// A batch split across threads in chunks, each chunk traced by `chunk(first, size, counters)`.
+// A batch split across threads in chunks of whole packets, each traced by
+// `chunk(first, size, stack, counters)` with the thread's single-ray stack (of stack_size
+// entries) and its counters (null when not counting).
 template <typename TraceChunk>
 void trace_in_chunks(size_t n, uint32_t stack_size, TraversalCounters* counters, const TraceChunk& chunk) {
   constexpr size_t kChunk = 256;  // rays a thread takes at a time (whole packets)
@@ -182,10 +184,10 @@ template void trace_wide<8>(const WideBvh<8>&, const std::vector<Ray>&, Query, s
 template void trace_wide<4>(const WideBvh<4>&, const Ray*, size_t, Query, Hit*, TraversalCounters*);
 template void trace_wide<8>(const WideBvh<8>&, const Ray*, size_t, Query, Hit*, TraversalCounters*);
 template void trace_wide<4>(const WideBvh<4>&, const Ray*, size_t, Query, Hit*, TraversalCounters*, CpuIsa);
+template void trace_wide<8>(const WideBvh<8>&, const Ray*, size_t, Query, Hit*, TraversalCounters*, CpuIsa);
 template void trace_wide_packets<4>(const WideBvh<4>&, const Ray*, size_t, Query, Hit*, TraversalCounters*, CpuIsa);
 template void trace_wide_packets<8>(const WideBvh<8>&, const Ray*, size_t, Query, Hit*, TraversalCounters*, CpuIsa);
 template void trace_wide_packet<4>(const WideBvh<4>&, const Ray*, unsigned, Query, Hit*);
 template void trace_wide_packet<8>(const WideBvh<8>&, const Ray*, unsigned, Query, Hit*);
-template void trace_wide<8>(const WideBvh<8>&, const Ray*, size_t, Query, Hit*, TraversalCounters*, CpuIsa);
 
 }  // namespace kmbvh
