@@ -104,29 +104,10 @@ TEST(Traversal, IdenticalTrianglesEveryBuilderEveryLayout) {
   expect_layouts_match_brute_force(scene, test::traversal_rays(scene, 500, 7), "identical");
 }
 
-// A tree whose depth is the number of triangles: node i has leaf i and node i + 1 below it.
-Bvh chain_tree(const PrimitiveSet& prims) {
-  const uint32_t n = uint32_t(prims.size());
-  Bvh bvh;
-  bvh.prim_indices.resize(n);
-  for (uint32_t i = 0; i < n; ++i) bvh.prim_indices[i] = i;
-  // Node layout: interior i at 2i, its children at 2i+1 (leaf i) and 2i+2 (interior i+1,
-  // or the last leaf).
-  bvh.nodes.resize(2 * n - 1);
-  Aabb below = prims.boxes[n - 1];
-  bvh.nodes[2 * n - 2] = BvhNode::make_leaf(below, n - 1, 1);
-  for (int i = int(n) - 2; i >= 0; --i) {
-    bvh.nodes[2 * i + 1] = BvhNode::make_leaf(prims.boxes[i], uint32_t(i), 1);
-    below = join(below, prims.boxes[i]);
-    bvh.nodes[2 * i] = BvhNode::make_interior(below, 2 * i + 1, 2);
-  }
-  return bvh;
-}
-
 TEST(Traversal, ChainDeeperThanAnyFixedStack) {
   const TriangleScene scene = test::random_triangles(4000, 33);
   const PrimitiveSet prims = make_primitive_set(scene);
-  const Bvh chain = chain_tree(prims);
+  const Bvh chain = test::chain_tree(prims);
   ASSERT_TRUE(validate(chain, prims, ValidationLimits{1, 2}).ok());
   const std::vector<Ray> rays = test::traversal_rays(scene, 400, 8);
   const std::vector<Hit> expected = brute_force(scene, rays, Query::Closest);
@@ -205,7 +186,7 @@ TEST(TraversalCounters, CountedByHandOnAThreeLeafTree) {
     }
   }
   // The portable BVH2 kernel counts nothing (a binary tree over the same triangles).
-  EXPECT_FALSE(Tracer(chain_tree(prims), prims, scene, Layout::Bvh2).count(rays, Query::Closest).has_value());
+  EXPECT_FALSE(Tracer(test::chain_tree(prims), prims, scene, Layout::Bvh2).count(rays, Query::Closest).has_value());
 }
 
 TEST(Traversal, EmbreeConventionsOnASquare) {

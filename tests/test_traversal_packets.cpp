@@ -134,18 +134,7 @@ TEST(PacketTraversal, InvalidLanesAreNotTouched) {
 TEST(PacketTraversal, ChainDeeperThanAnyFixedStack) {
   const TriangleScene scene = test::random_triangles(3000, 43);
   const PrimitiveSet prims = make_primitive_set(scene);
-  Bvh chain;
-  const uint32_t n = uint32_t(prims.size());
-  chain.prim_indices.resize(n);
-  for (uint32_t i = 0; i < n; ++i) chain.prim_indices[i] = i;
-  chain.nodes.resize(2 * n - 1);
-  Aabb below = prims.boxes[n - 1];
-  chain.nodes[2 * n - 2] = BvhNode::make_leaf(below, n - 1, 1);
-  for (int i = int(n) - 2; i >= 0; --i) {
-    chain.nodes[2 * i + 1] = BvhNode::make_leaf(prims.boxes[i], uint32_t(i), 1);
-    below = join(below, prims.boxes[i]);
-    chain.nodes[2 * i] = BvhNode::make_interior(below, 2 * i + 1, 2);
-  }
+  const Bvh chain = test::chain_tree(prims);
   const Bvh tree = collapse_to_width(chain, 8);
   const WideBvh<8> wide = make_wide_bvh<8>(tree, leaf_triangles(tree, prims, scene));
   EXPECT_GE(wide.stack_size, 3000u / 7);

@@ -126,4 +126,24 @@ std::vector<kmbvh::Ray> traversal_rays(const TriangleScene& scene, uint32_t n, u
   return rays;
 }
 
+
+// Node i has leaf i and node i + 1 below it (rays.h).
+Bvh chain_tree(const PrimitiveSet& prims) {
+  const uint32_t n = uint32_t(prims.size());
+  Bvh bvh;
+  bvh.prim_indices.resize(n);
+  for (uint32_t i = 0; i < n; ++i) bvh.prim_indices[i] = i;
+  // Node layout: interior i at 2i, its children at 2i+1 (leaf i) and 2i+2 (interior i+1,
+  // or the last leaf).
+  bvh.nodes.resize(2 * n - 1);
+  Aabb below = prims.boxes[n - 1];
+  bvh.nodes[2 * n - 2] = BvhNode::make_leaf(below, n - 1, 1);
+  for (int i = int(n) - 2; i >= 0; --i) {
+    bvh.nodes[2 * i + 1] = BvhNode::make_leaf(prims.boxes[i], uint32_t(i), 1);
+    below = join(below, prims.boxes[i]);
+    bvh.nodes[2 * i] = BvhNode::make_interior(below, 2 * i + 1, 2);
+  }
+  return bvh;
+}
+
 }  // namespace kmbvh::test

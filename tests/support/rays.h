@@ -42,4 +42,8 @@ Ray ray_towards_triangle(const TriangleScene& scene, uint32_t seed, uint32_t ind
 // by ray_towards_triangle (seed + 1); every seventh bounded (tfar 0.5), the rest unbounded.
 std::vector<kmbvh::Ray> traversal_rays(const TriangleScene& scene, uint32_t n, uint32_t seed);
 
+// A tree whose depth is the number of primitives (node i has leaf i and node i + 1 below
+// it), for the stack bounds of every traversal.
+Bvh chain_tree(const PrimitiveSet& prims);
+
 }  // namespace kmbvh::test
