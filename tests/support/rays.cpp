@@ -126,7 +126,6 @@ std::vector<kmbvh::Ray> traversal_rays(const TriangleScene& scene, uint32_t n, u
   return rays;
 }
 
-
 // Node i has leaf i and node i + 1 below it (rays.h).
 Bvh chain_tree(const PrimitiveSet& prims) {
   const uint32_t n = uint32_t(prims.size());
