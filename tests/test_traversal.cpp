@@ -242,6 +242,51 @@ TEST(Traversal, EmbreeConventionsOnASquare) {
   }
 }
 
+// Two rays of Embree's pathtracer on conference.obj (KMBVH_AB) past needles seen along their
+// length, 900 units from the origin: the float watertight test hits needle 0, which the ray
+// passes by 7.6e-5 of its width, and triangle 3, passed by 1.6e-5, where the exact test hits
+// their neighbours across the shared edge (1 and 4). Whatever the tree, the wide layouts
+// report the exact answer (trace_wide_kernel.inl: outside_by_exact_check, traverse_exact).
+TEST(Traversal, NeedlesPassedByTheFloatTestAreTracedExactly) {
+  TriangleScene scene;
+  scene.add_triangle(Vec3(495.409f, 116.18f, -852.146f), Vec3(504.093f, 108.876f, -946.03f), Vec3(495.83f, 115.964f, -852.09f));
+  scene.add_triangle(Vec3(504.093f, 108.876f, -946.03f), Vec3(504.515f, 108.66f, -945.974f), Vec3(495.83f, 115.964f, -852.09f));
+  scene.add_triangle(Vec3(502.166f, 106.96f, -946.06f), Vec3(502.095f, 107.43f, -946.103f), Vec3(493.41f, 114.734f, -852.218f));
+  scene.add_triangle(Vec3(80.715f, 650.293f, -1042.62f), Vec3(78.5176f, 650.293f, -1035.88f), Vec3(78.5176f, 210.833f, -1035.88f));
+  scene.add_triangle(Vec3(78.5176f, 210.833f, -1035.88f), Vec3(78.5176f, 650.293f, -1035.88f), Vec3(76.3201f, 210.833f, -1029.14f));
+  const std::vector<Ray> rays = {
+      make_ray(Vec3(1179.3667f, 650.288513f, -823.135803f), Vec3(-0.772921026f, -0.619317412f, -0.137981474f), 0.00449891575f),
+      make_ray(Vec3(1653.24365f, 81.1547318f, 212.555176f), Vec3(-0.772132456f, 0.170565173f, -0.612142801f), 0.00630663289f)};
+  // The premise: the float test alone takes the needle the ray passes.
+  const Triangle& passed = scene.triangles[0];
+  Hit h;
+  ASSERT_TRUE(intersect_watertight(RayShear(rays[0]), rays[0].tnear, kInf, scene.positions[passed[0]],
+                                   scene.positions[passed[1]], scene.positions[passed[2]], h));
+  const uint32_t expected[] = {1, 4};
+  const PrimitiveSet prims = make_primitive_set(scene);
+  for (const char* spec : {"sweep-sah", "lbvh"}) {
+    const Bvh bvh = run_builder(test::config_from_spec(spec), prims);
+    for (const Layout layout : {Layout::Bvh4, Layout::Bvh8}) {
+      const Tracer tracer(bvh, prims, scene, layout);
+      std::vector<Hit> hits;
+      tracer.trace(rays, Query::Closest, hits);
+      for (size_t r = 0; r < rays.size(); ++r) {
+        ASSERT_TRUE(hits[r].found()) << spec << ", ray " << r;
+        EXPECT_EQ(hits[r].primID, expected[r]) << spec << ", " << to_string(layout) << ", ray " << r;
+        EXPECT_GE(hits[r].u, 0.0f);
+        EXPECT_GE(hits[r].v, 0.0f);
+        EXPECT_LE(hits[r].u + hits[r].v, 1.0f + 1e-6f);
+      }
+      std::vector<Hit> packet(rays.size());
+      tracer.trace_packet(rays.data(), 0b11, Query::Closest, packet.data());
+      for (size_t r = 0; r < rays.size(); ++r) EXPECT_EQ(std::memcmp(&packet[r], &hits[r], sizeof(Hit)), 0) << "ray " << r;
+      const std::optional<TraversalCounters> counted = tracer.count(rays, Query::Closest);
+      ASSERT_TRUE(counted.has_value());
+      EXPECT_EQ(counted->exact_retraces, 2u) << spec << ", " << to_string(layout);
+    }
+  }
+}
+
 TEST(Traversal, EmptyAndTinyScenes) {
   for (const uint32_t n : {0u, 1u, 2u}) {
     TriangleScene scene;

@@ -19,7 +19,7 @@ namespace {
 
 bool same_counts(const TraversalCounters& a, const TraversalCounters& b) {
   return a.rays == b.rays && a.nodes == b.nodes && a.packs == b.packs && a.triangles == b.triangles &&
-         a.exact_checks == b.exact_checks;
+         a.exact_checks == b.exact_checks && a.exact_retraces == b.exact_retraces;
 }
 
 template <int W>

@@ -21,6 +21,7 @@ TraversalCounters& TraversalCounters::operator+=(const TraversalCounters& o) {
   packs += o.packs;
   triangles += o.triangles;
   exact_checks += o.exact_checks;
+  exact_retraces += o.exact_retraces;
   return *this;
 }
 

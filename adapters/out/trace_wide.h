@@ -22,6 +22,7 @@ struct TraversalCounters {
   uint64_t packs = 0;         // leaf triangle packs tested
   uint64_t triangles = 0;     // triangles in those packs (used slots only)
   uint64_t exact_checks = 0;  // candidate hits confirmed in double precision (watertight.h: exact_check)
+  uint64_t exact_retraces = 0;  // rays traced again with every triangle tested in double precision
   TraversalCounters& operator+=(const TraversalCounters& o);
 };
 

@@ -147,12 +147,14 @@ struct NoTally {
   void node() {}
   void pack(uint32_t) {}
   void exact() {}
+  void retrace() {}
 };
 struct Tally {
   TraversalCounters c;
   void node() { ++c.nodes; }
   void pack(uint32_t triangles) { ++c.packs, c.triangles += triangles; }
   void exact() { ++c.exact_checks; }
+  void retrace() { ++c.exact_retraces; }
 };
 
 // The watertight test's per-ray set-up, broadcast to the slots of a pack.
@@ -509,9 +511,80 @@ __attribute__((always_inline)) inline bool descend(const WideBvh<W>& bvh, const 
   }
 }
 
+// A closest-hit ray traced again with every triangle it reaches tested in double precision
+// (intersect_watertight_exact), the closest by exact t, ties by tie_key; the boxes as the
+// float traversal tests them, with cull_reach's margin past the closest t. For the rare ray
+// whose answer the float test cannot be trusted with (conclude); unordered, as occlusion
+// descends, so the stack bound holds.
+template <int W, typename Count>
+__attribute__((noinline)) bool traverse_exact(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit,
+                                              Count& count, TraversalCounters* counted) {
+  count.retrace();
+  const RaySetup setup(ray);
+  const WideRay<W> wray(ray, setup);
+  const RayShearExact shear(ray);
+  double best = ray.tfar;
+  uint32_t found = kInvalidId;
+  uint64_t found_key = kNoCandidate;
+  float cull = ray.tfar, pop = ray.tfar * kRobustExit;
+  uint32_t sp = 0;
+  stack[sp++] = WideEntry{0, 0, ray.tnear};
+  while (sp > 0) {
+    const WideEntry cur = stack[--sp];
+    if (cur.entry > pop) continue;
+    if (cur.count == 0) {
+      const WideNode<W>& n = bvh.nodes[cur.ref];
+      count.node();
+      typename Lanes<W>::V entry;
+      for (unsigned mask = enter_children(n, wray, cull, entry); mask; mask &= mask - 1) {
+        const int lane = __builtin_ctz(mask);
+        stack[sp++] = WideEntry{n.ref[lane], n.count[lane], entry[lane]};
+      }
+      continue;
+    }
+    for (uint32_t i = 0; i < cur.count; ++i) {
+      const uint32_t triangle = cur.ref * kPackWidth + i;
+      const TrianglePack& p = bvh.packs[triangle / kPackWidth];
+      const uint32_t slot = triangle % kPackWidth;
+      if (i % kPackWidth == 0) count.pack(std::min<uint32_t>(kPackWidth, cur.count - i));
+      double t;
+      if (!intersect_watertight_exact(shear, ray.tnear, best, slot_vertex(p, 0, slot), slot_vertex(p, 1, slot),
+                                      slot_vertex(p, 2, slot), t))
+        continue;
+      const uint64_t key = tie_key(p.id[slot]);
+      if (t == best && key > found_key) continue;
+      best = t, found = triangle, found_key = key;
+      cull = cull_reach(float(best));  // float(best) may round down by half an ulp: within the margin
+      pop = cull * kPopReach;
+    }
+  }
+  ExactCheck check;
+  if (found != kInvalidId) {
+    const TrianglePack& p = bvh.packs[found / kPackWidth];
+    const uint32_t slot = found % kPackWidth;
+    count.exact();
+    check = exact_check(ray, slot_vertex(p, 0, slot), slot_vertex(p, 1, slot), slot_vertex(p, 2, slot), ray.tnear,
+                        ray.tfar);
+    hit.t = float(best);
+  }
+  return finish(count, counted, finish_hit(bvh, found, check, hit));
+}
+
+// Whether the float test's closest candidate may not be the ray's closest hit: the exact
+// measure (e) puts the ray outside the triangle, so the float test passed it by more than
+// rounding. That happens on a needle seen along its length, whose float shear moves the
+// edge functions by 1e-4 of its width; found by the A/B mode in Embree's pathtracer on
+// conference (docs/design.md §8). A ray through an edge, whose exact barycentric is zero,
+// stays within the margin; the oracle's tolerance (hit_compare.cpp, 1e-5) is ten times it.
+inline bool outside_by_exact_check(const ExactCheck& e) {
+  constexpr double kOutside = 0x1p-20;
+  const double u = e.u, v = e.v;
+  return e.measured && (u < -kOutside || v < -kOutside || 1.0 - u - v < -kOutside);
+}
+
 // The answer once every descent is over: with Deferred, the closest candidate's exact check
-// over the interval it was accepted in (a failed one traces the ray again with Exact);
-// then its hit completed.
+// over the interval it was accepted in (a failed one traces the ray again with Exact, a
+// doubtful one with traverse_exact); then its hit completed.
 template <int W, Query query, bool Filtered, Confirm confirm, typename Count>
 __attribute__((always_inline)) inline bool conclude(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack,
                                                     Search& s, Hit& hit, Count& count, TraversalCounters* counted) {
@@ -522,6 +595,7 @@ __attribute__((always_inline)) inline bool conclude(const WideBvh<W>& bvh, const
       count.exact();
       s.check = exact_check(ray, slot_vertex(p, 0, slot), slot_vertex(p, 1, slot), slot_vertex(p, 2, slot),
                             ray.tnear, s.found_bound);
+      if (outside_by_exact_check(s.check)) return traverse_exact<W>(bvh, ray, stack, hit, count, counted);
       if (!s.check.within)  // a needle's float t was off: once more, every candidate checked
         return traverse<W, query, false, Count, Confirm::Exact>(bvh, ray, stack, hit, nullptr, count, counted);
     }

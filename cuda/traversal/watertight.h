@@ -84,6 +84,46 @@ KMBVH_HD KMBVH_INLINE bool intersect_watertight(const RayShear& s, float tnear, 
   return true;
 }
 
+// The same test in double precision, the shear too (from the float ray, once per ray), for
+// the rare ray the float test cannot answer: on a needle seen along its length, the float
+// shear of vertices far from the origin moves the edge functions by 1e-4 of the triangle's
+// width, enough to hit a needle the ray passes, or to misplace a needle's t past a nearer
+// one (conclude in trace_wide_kernel.inl). Watertight as the float test is: both triangles
+// of a shared vertex shear it to the same coordinates, so a shared edge's function has
+// opposite signs in the two, and the subtraction rounds symmetrically.
+struct RayShearExact {
+  double ox, oy, oz;
+  int kx = 0, ky = 1, kz = 2;
+  double sx = 0, sy = 0, sz = 1;
+
+  KMBVH_HD explicit RayShearExact(const Ray& ray) : ox(ray.org.x), oy(ray.org.y), oz(ray.org.z) {
+    const RayShear f(ray);  // the same axes as the float test
+    kx = f.kx, ky = f.ky, kz = f.kz;
+    sz = 1.0 / double(ray.dir[kz]);
+    sx = double(ray.dir[kx]) * sz;
+    sy = double(ray.dir[ky]) * sz;
+  }
+};
+
+// Whether the ray hits (a, b, c) for tnear < t <= tmax, by the double-precision test; its t.
+KMBVH_HD KMBVH_INLINE bool intersect_watertight_exact(const RayShearExact& s, double tnear, double tmax, Vec3 a, Vec3 b,
+                                                      Vec3 c, double& t) {
+  const double o[3] = {s.ox, s.oy, s.oz};
+  const double A[3] = {a.x - o[0], a.y - o[1], a.z - o[2]};
+  const double B[3] = {b.x - o[0], b.y - o[1], b.z - o[2]};
+  const double C[3] = {c.x - o[0], c.y - o[1], c.z - o[2]};
+  const double ax = A[s.kx] - s.sx * A[s.kz], ay = A[s.ky] - s.sy * A[s.kz];
+  const double bx = B[s.kx] - s.sx * B[s.kz], by = B[s.ky] - s.sy * B[s.kz];
+  const double cx = C[s.kx] - s.sx * C[s.kz], cy = C[s.ky] - s.sy * C[s.kz];
+  const double U = cx * by - cy * bx, V = ax * cy - ay * cx, W = bx * ay - by * ax;
+  if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0)) return false;
+  const double det = U + V + W;
+  if (!(det != 0.0)) return false;  // NaN too: a degenerate triangle's layout slot
+  const double T = U * (s.sz * A[s.kz]) + V * (s.sz * B[s.kz]) + W * (s.sz * C[s.kz]);
+  t = T / det;
+  return t > tnear && t <= tmax;
+}
+
 // A triangle's edges from its first vertex, in double precision (exact: each is the
 // difference of two floats).
 struct ExactEdges {

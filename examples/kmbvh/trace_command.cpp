@@ -97,14 +97,17 @@ Json counters_json(const TraversalCounters& c) {
               {"nodes", c.nodes},
               {"packs", c.packs},
               {"triangles", c.triangles},
-              {"exact_checks", c.exact_checks}};
+              {"exact_checks", c.exact_checks},
+              {"exact_retraces", c.exact_retraces}};
 }
 
 void print_counters(const KindResult& r) {
   if (!r.counters) return;
   const TraversalCounters& c = *r.counters;
-  fmt::print("  {} per ray: {:.2f} nodes, {:.2f} leaf packs, {:.2f} triangles, {:.2f} exact checks\n", to_string(r.kind),
-             per_ray(c.nodes, c), per_ray(c.packs, c), per_ray(c.triangles, c), per_ray(c.exact_checks, c));
+  fmt::print("  {} per ray: {:.2f} nodes, {:.2f} leaf packs, {:.2f} triangles, {:.2f} exact checks; {} rays retraced in "
+             "double precision\n",
+             to_string(r.kind), per_ray(c.nodes, c), per_ray(c.packs, c), per_ray(c.triangles, c),
+             per_ray(c.exact_checks, c), c.exact_retraces);
 }
 
 
