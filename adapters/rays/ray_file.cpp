@@ -62,6 +62,7 @@ std::vector<RecordedRay> read_recorded_rays(const std::string& path) {
           r.kind = m.at("kind").get<std::string>();
           r.form = form.at("form").get<std::string>();
           r.scene = scene.at("scene").get<std::string>();
+          r.scene_file = scene.value("scene_file", std::string());
           r.kmbvh = hit_of(m.at("kmbvh"));
           r.embree = hit_of(m.at("embree"));
           rays.push_back(std::move(r));

@@ -18,6 +18,7 @@ struct RecordedRay {
   std::string kind;     // the mismatch it was reported as ("distance", ...)
   std::string form;     // the application's query function ("rtcIntersect1", ...)
   std::string scene;    // the scene entry of the report it came from
+  std::string scene_file;  // the OBJ the report saved that scene to ("" if none was saved)
   // The answers in the report; a closest hit names its triangle's position in the saved
   // scene (primID), geomID 0.
   Hit kmbvh, embree;

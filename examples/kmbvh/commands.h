@@ -144,5 +144,8 @@ struct LoadedScene;
 // trace --replay (replay.cpp): the report's recorded rays through kmbvh's layouts of `bvh`
 // and through Embree, on the scene loaded for the command.
 int replay_recorded_rays(const TraceCommand& command, const LoadedScene& scene, const Bvh& bvh);
+// The scene file the report saved beside its rays, for a replay that names no scene; ""
+// after saying on stderr why there is none (an unreadable report, no scene saved).
+std::string replay_scene_file(const std::string& report);
 
 }  // namespace kmbvh

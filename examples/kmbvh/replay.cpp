@@ -41,6 +41,19 @@ const char* verdict_text(const HitComparison& c) {
 
 }  // namespace
 
+std::string replay_scene_file(const std::string& report) {
+  try {
+    for (const RecordedRay& r : read_recorded_rays(report))
+      if (!r.scene_file.empty()) return r.scene_file;
+  } catch (const RayFileError& e) {
+    fmt::print(stderr, "kmbvh trace: {}\n", e.what());
+    return {};
+  }
+  fmt::print(stderr, "kmbvh trace: {}: the report saved no scene beside its rays; name the application's scene: kmbvh "
+             "trace SCENE --replay {}\n", report, report);
+  return {};
+}
+
 int replay_recorded_rays(const TraceCommand& c, const LoadedScene& scene, const Bvh& bvh) {
   std::vector<RecordedRay> recorded;
   try {

@@ -192,7 +192,7 @@ void add_trace_command(CLI::App& app, TraceCommand& c) {
   cmd->add_option("--show", c.show, "mismatching rays printed in full");
   cmd->add_option("--replay", c.replay,
                   "trace the mismatching rays an A/B report of the preload library recorded (KMBVH_AB_REPORT), on the "
-                  "scene it saved beside them, with kmbvh and Embree")
+                  "scene it saved beside them (the default for SCENE), with kmbvh and Embree")
       ->check(CLI::ExistingFile);
   add_run_options(*cmd, c.run);
 }
@@ -205,8 +205,13 @@ int run_trace(const TraceCommand& c) {
   for (const Layout layout : layouts)
     if (layout != Layout::Bvh2) traversal_isa();  // a KMBVH_ISA this CPU cannot run fails now, not after the build
   Progress progress(c.run.quiet);
-  progress.update(fmt::format("loading {}", c.scene.empty() ? "the default scene" : c.scene));
-  const LoadedScene scene = load_scene_argument(c.scene);
+  std::string scene_name = c.scene;
+  if (!c.replay.empty() && scene_name.empty()) {  // the scene the report saved beside its rays
+    scene_name = replay_scene_file(c.replay);
+    if (scene_name.empty()) return kExitBadInput;
+  }
+  progress.update(fmt::format("loading {}", scene_name.empty() ? "the default scene" : scene_name));
+  const LoadedScene scene = load_scene_argument(scene_name);
 
   progress.update(fmt::format("building with {}", config.label()));
   prepare_builder(config);

@@ -2,7 +2,7 @@
 # and KMBVH_AB_REPORT, and its JSON report must say what EXPECT says:
 #   zero       compared >= MIN_COMPARED, no mismatch
 #   hit_miss, distance, primitive (with KMBVH_AB_PERTURB in ENV): mismatches of that kind,
-#              recorded in full; `kmbvh trace SAVED_SCENE --replay REPORT` (REPLAY: the
+#              recorded in full; `kmbvh trace --replay REPORT` (REPLAY: the
 #              kmbvh binary) finds Embree's recorded answers again and no mismatch
 #   fallback   a scene Embree answers, reported with its reason and not compared
 #   builds     rtcBuildBVH built by both (the program: kmbvh_example_custom_bvh_embree, run
@@ -126,9 +126,10 @@ else()
   if(NOT saved OR NOT EXISTS "${saved}")
     message(FATAL_ERROR "the scene of the mismatches was not saved beside the report")
   endif()
-  # The perturbation spoilt kmbvh's answers in the application; replayed, kmbvh agrees and
-  # Embree answers as it did there.
-  execute_process(COMMAND "${REPLAY}" trace "${saved}" --replay "${report}" --layout bvh2,bvh8 --quiet
+  # The perturbation spoilt kmbvh's answers in the application; replayed (on the scene the
+  # report saved, which the replay finds by itself), kmbvh agrees and Embree answers as it
+  # did there.
+  execute_process(COMMAND "${REPLAY}" trace --replay "${report}" --layout bvh2,bvh8 --quiet
                   RESULT_VARIABLE rc OUTPUT_VARIABLE replayed)
   message("${replayed}")
   if(NOT rc EQUAL 0 OR NOT replayed MATCHES "([0-9]+) of ([0-9]+) rays: Embree's answer as reported; 0 mismatches now"
