@@ -85,6 +85,8 @@ PluginConfig read_plugin_config() {
     throw std::invalid_argument("KMBVH_BACKEND=" + backend + ": expected cpu or cuda");
   c.log = log_requested();
   c.ab = read_ab_config();
+  c.record_rays = env("KMBVH_RECORD_RAYS");
+  if (const uint32_t n = env_count("KMBVH_RECORD_LIMIT", 1, 1u << 30)) c.record_limit = n;
   return c;
 }
 

@@ -10,6 +10,9 @@
 //                  KMBVH_AB_ANSWER=kmbvh|embree says whose answer the application gets,
 //                  KMBVH_AB_REPORT=FILE writes the report as JSON, KMBVH_AB_PERTURB (tests
 //                  only) spoils kmbvh's answers so the oracle can be seen to fail
+//   KMBVH_RECORD_RAYS=FILE   the queries kmbvh answers on one scene, recorded for
+//                  `kmbvh trace --rays-file` (preload/ray_recorder.h); KMBVH_RECORD_LIMIT=N
+//                  queries at most (2,000,000)
 #pragma once
 
 #include <embree3/rtcore.h>
@@ -40,6 +43,8 @@ struct PluginConfig {
   Backend backend = Backend::Cpu;
   bool log = false;
   AbConfig ab;
+  std::string record_rays;  // KMBVH_RECORD_RAYS: the file, or empty
+  uint32_t record_limit = 2000000;
 };
 
 // Throws std::invalid_argument naming the variable and its bad value.

@@ -102,5 +102,57 @@ TEST(RayFile, WhatIsNotAReportIsRefusedWithItsName) {
   EXPECT_THROW(read_recorded_rays(temp_path("kmbvh_no_such_report.json")), RayFileError);
 }
 
+// A file as the preload library writes it (ray_recorder.cpp): the magic, then the records.
+void write_app_rays(const std::string& path, const std::vector<AppRayRecord>& records, size_t cut = 0) {
+  std::ofstream out(path, std::ios::binary);
+  out.write(kAppRaysMagic, sizeof(kAppRaysMagic));
+  out.write(reinterpret_cast<const char*>(records.data()), std::streamsize(records.size() * sizeof(AppRayRecord) - cut));
+}
+
+TEST(RayFile, ApplicationRaysReadBackByQueryUpToTheLimit) {
+  const std::string path = temp_path("kmbvh_app_rays.bin");
+  const float inf = std::numeric_limits<float>::infinity();
+  std::vector<AppRayRecord> records;
+  for (uint32_t i = 0; i < 7; ++i)
+    records.push_back(AppRayRecord{{float(i), 0.5f, -1e-30f}, {0.0f, 0.0f, 1.0f}, 1e-3f * float(i), i % 3 ? inf : 2.5f, i % 2});
+  write_app_rays(path, records);
+  const AppRays all = read_app_rays(path, 100);
+  ASSERT_EQ(all.closest.size(), 4u);  // 0, 2, 4, 6
+  ASSERT_EQ(all.occlusion.size(), 3u);
+  EXPECT_EQ(all.closest[1].org.x, 2.0f);
+  EXPECT_EQ(all.closest[1].org.z, -1e-30f);
+  EXPECT_EQ(all.closest[1].tnear, 2e-3f);
+  EXPECT_EQ(all.closest[1].tfar, inf);
+  EXPECT_EQ(all.closest[0].tfar, 2.5f);
+  EXPECT_EQ(all.occlusion[2].org.x, 5.0f);
+  EXPECT_EQ(all.occlusion[2].dir.z, 1.0f);
+  const AppRays first = read_app_rays(path, 2);  // the first ones of each query
+  ASSERT_EQ(first.closest.size(), 2u);
+  ASSERT_EQ(first.occlusion.size(), 2u);
+  EXPECT_EQ(first.occlusion[1].org.x, 3.0f);
+}
+
+TEST(RayFile, BrokenApplicationRayFilesAreRefusedWithTheirName) {
+  const std::string path = temp_path("kmbvh_app_rays_broken.bin");
+  const std::vector<AppRayRecord> records(3, AppRayRecord{{0, 0, 0}, {0, 0, 1}, 0.0f, 1.0f, 0});
+  const auto message = [&] {
+    try {
+      read_app_rays(path, 10);
+    } catch (const RayFileError& e) {
+      return std::string(e.what());
+    }
+    return std::string("no error");
+  };
+  write_app_rays(path, records, 5);
+  EXPECT_NE(message().find(path + ": ends inside a ray"), std::string::npos) << message();
+  std::vector<AppRayRecord> bad_query = records;
+  bad_query[1].query = 7;
+  write_app_rays(path, bad_query);
+  EXPECT_NE(message().find("ray 1 has query 7"), std::string::npos) << message();
+  std::ofstream(path) << "{\"scenes\": []}";
+  EXPECT_NE(message().find("not a ray file"), std::string::npos) << message();
+  EXPECT_THROW(read_app_rays(temp_path("kmbvh_no_such_rays.bin"), 10), RayFileError);
+}
+
 }  // namespace
 }  // namespace kmbvh

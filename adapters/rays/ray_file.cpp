@@ -3,6 +3,7 @@
 #include <fmt/format.h>
 
 #include <cmath>
+#include <cstring>
 #include <fstream>
 #include <limits>
 #include <nlohmann/json.hpp>
@@ -70,6 +71,29 @@ std::vector<RecordedRay> read_recorded_rays(const std::string& path) {
   } catch (const std::exception& e) {  // nlohmann's parse and type errors, and ours
     throw RayFileError(fmt::format("{}: not an A/B report of kmbvh's preload library ({})", path, e.what()));
   }
+  return rays;
+}
+
+AppRays read_app_rays(const std::string& path, size_t limit) {
+  std::ifstream in(path, std::ios::binary);
+  if (!in) throw RayFileError(fmt::format("{}: cannot be read", path));
+  char magic[sizeof(kAppRaysMagic)] = {};
+  if (!in.read(magic, sizeof(magic)) || std::memcmp(magic, kAppRaysMagic, sizeof(magic)) != 0)
+    throw RayFileError(fmt::format("{}: not a ray file of kmbvh's preload library (KMBVH_RECORD_RAYS)", path));
+  AppRays rays;
+  AppRayRecord r;
+  for (size_t i = 0; in.read(reinterpret_cast<char*>(&r), sizeof(r)); ++i) {
+    if (r.query > 1) throw RayFileError(fmt::format("{}: ray {} has query {}, expected 0 or 1", path, i, r.query));
+    std::vector<Ray>& out = r.query == 0 ? rays.closest : rays.occlusion;
+    if (out.size() >= limit) continue;
+    Ray ray;
+    ray.org = Vec3(r.org[0], r.org[1], r.org[2]);
+    ray.dir = Vec3(r.dir[0], r.dir[1], r.dir[2]);
+    ray.tnear = r.tnear;
+    ray.tfar = r.tfar;
+    out.push_back(ray);
+  }
+  if (in.gcount() != 0) throw RayFileError(fmt::format("{}: ends inside a ray (truncated)", path));
   return rays;
 }
 

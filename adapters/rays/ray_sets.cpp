@@ -40,14 +40,25 @@ const char* to_string(RayKind kind) {
     case RayKind::Primary: return "primary";
     case RayKind::Shadow: return "shadow";
     case RayKind::Diffuse: return "diffuse";
+    case RayKind::AppClosest: return "app-closest";
+    case RayKind::AppOcclusion: return "app-occlusion";
   }
   return "?";
 }
 
-Query query_for(RayKind kind) { return kind == RayKind::Shadow ? Query::Any : Query::Closest; }
+Query query_for(RayKind kind) {
+  return kind == RayKind::Shadow || kind == RayKind::AppOcclusion ? Query::Any : Query::Closest;
+}
 
 const std::vector<Ray>& RaySets::of(RayKind kind) const {
-  return kind == RayKind::Primary ? primary : kind == RayKind::Shadow ? shadow : diffuse;
+  switch (kind) {
+    case RayKind::Primary: return primary;
+    case RayKind::Shadow: return shadow;
+    case RayKind::Diffuse: return diffuse;
+    case RayKind::AppClosest: return app_closest;
+    case RayKind::AppOcclusion: return app_occlusion;
+  }
+  return primary;
 }
 
 Vec3 scene_light(const Aabb& bounds) {

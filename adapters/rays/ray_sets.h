@@ -13,10 +13,14 @@
 
 namespace kmbvh {
 
-enum class RayKind { Primary, Shadow, Diffuse };
-const char* to_string(RayKind kind);
+// The three kinds made here, then the two an application's recorded rays give
+// (kmbvh trace --rays-file: its closest-hit and its occlusion queries).
+enum class RayKind { Primary, Shadow, Diffuse, AppClosest, AppOcclusion };
+constexpr int kRayKinds = 5;
+const char* to_string(RayKind kind);  // "primary", ..., "app-closest", "app-occlusion"
 
-// The query each kind is traced with: shadow rays ask for any hit, the others the closest.
+// The query each kind is traced with: shadow and occlusion rays ask for any hit, the others
+// the closest.
 Query query_for(RayKind kind);
 
 // Answers closest-hit queries: used to find where primary rays land.
@@ -24,6 +28,7 @@ using ClosestHits = std::function<void(const std::vector<Ray>&, std::vector<Hit>
 
 struct RaySets {
   std::vector<Ray> primary, shadow, diffuse;
+  std::vector<Ray> app_closest, app_occlusion;  // empty unless read from a ray file
   const std::vector<Ray>& of(RayKind kind) const;
 };
 

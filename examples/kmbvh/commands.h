@@ -103,6 +103,7 @@ struct TraceCommand {
   bool compare_embree = false;
   size_t show = 5;               // mismatching rays printed in full
   std::string replay;            // an A/B report of the preload library: its rays instead (replay.cpp)
+  std::string rays_file;         // an application's rays recorded by the preload (KMBVH_RECORD_RAYS) instead
 };
 
 // kmbvh stress [CASES...]: every builder on the generated stress cases.

@@ -15,6 +15,7 @@
 #include "adapters/out/cpu_isa.h"
 #include "adapters/out/tracer.h"
 #include "adapters/rays/hit_compare.h"
+#include "adapters/rays/ray_file.h"
 #include "adapters/rays/scene_rays.h"
 #include "commands.h"
 #include "cuda/core/threads.h"
@@ -190,6 +191,11 @@ void add_trace_command(CLI::App& app, TraceCommand& c) {
   cmd->add_option("--ray-seed", c.ray_seed, "seed of the rays' random draws");
   cmd->add_flag("--compare-embree", c.compare_embree, "trace the same rays with Embree and count every difference");
   cmd->add_option("--show", c.show, "mismatching rays printed in full");
+  cmd->add_option("--rays-file", c.rays_file,
+                  "trace an application's rays recorded by the preload library (KMBVH_RECORD_RAYS) instead of "
+                  "making rays: its closest-hit queries (app-closest) and its occlusion queries (app-occlusion), at "
+                  "most --count of each")
+      ->check(CLI::ExistingFile);
   cmd->add_option("--replay", c.replay,
                   "trace the mismatching rays an A/B report of the preload library recorded (KMBVH_AB_REPORT), on the "
                   "scene it saved beside them (the default for SCENE), with kmbvh and Embree")
@@ -201,7 +207,25 @@ int run_trace(const TraceCommand& c) {
   apply_run_options(c.run);
   const BuilderConfig config = builder_config(c.builder, c.run);
   const std::vector<Layout>& layouts = c.layouts;
-  const std::vector<RayKind>& kinds = c.rays;
+  std::vector<RayKind> kinds = c.rays;
+  RaySets rays;
+  if (!c.rays_file.empty()) {  // read first: a bad file is refused before the build
+    try {
+      AppRays recorded = read_app_rays(c.rays_file, c.count);
+      rays.app_closest = std::move(recorded.closest);
+      rays.app_occlusion = std::move(recorded.occlusion);
+    } catch (const RayFileError& e) {
+      fmt::print(stderr, "kmbvh trace: {}\n", e.what());
+      return kExitBadInput;
+    }
+    kinds.clear();
+    if (!rays.app_closest.empty()) kinds.push_back(RayKind::AppClosest);
+    if (!rays.app_occlusion.empty()) kinds.push_back(RayKind::AppOcclusion);
+    if (kinds.empty()) {
+      fmt::print(stderr, "kmbvh trace: {}: holds no rays\n", c.rays_file);
+      return kExitBadInput;
+    }
+  }
   for (const Layout layout : layouts)
     if (layout != Layout::Bvh2) traversal_isa();  // a KMBVH_ISA this CPU cannot run fails now, not after the build
   Progress progress(c.run.quiet);
@@ -221,11 +245,13 @@ int run_trace(const TraceCommand& c) {
     return replay_recorded_rays(c, scene, bvh);
   }
 
-  progress.update("making rays");
-  const RaySets rays = scene_ray_sets(scene.geometry, scene.prims, c.count, c.ray_seed);
+  if (c.rays_file.empty()) {
+    progress.update("making rays");
+    rays = scene_ray_sets(scene.geometry, scene.prims, c.count, c.ray_seed);
+  }
 
   std::optional<EmbreeScene> embree;
-  std::vector<EmbreeResult> embree_results(3);
+  std::vector<EmbreeResult> embree_results(kRayKinds);
   if (c.compare_embree) {
     progress.update("committing Embree's scene");
     embree.emplace(scene.geometry);
@@ -249,6 +275,7 @@ int run_trace(const TraceCommand& c) {
            {"sah_cost", sah_cost(bvh)},
            {"rays_per_kind", c.count},
            {"ray_seed", c.ray_seed},
+           {"rays_file", c.rays_file},
            {"compare_embree", c.compare_embree}};
   if (embree) out["embree_commit_ms"] = embree->commit_ms();
   Json layout_rows = Json::array();
@@ -328,17 +355,17 @@ int run_trace(const TraceCommand& c) {
                tracer.collapsed() ? " (collapsed by SAH from the binary tree)" : "", traced_sah,
                double(tracer.layout_bytes()) / (1 << 20), tracer.layout_ms(),
                layout == Layout::Bvh2 ? "" : fmt::format(" · {} kernel", to_string(traversal_isa())));
-    fmt::print("{:<8} {:>8} {:>13} {:>13} {:>7} {:>13} {:>10} {:>9}\n", "rays", "count", "kmbvh Mrays/s", "rtc*1 Mrays/s",
+    fmt::print("{:<13} {:>8} {:>13} {:>13} {:>7} {:>13} {:>10} {:>9}\n", "rays", "count", "kmbvh Mrays/s", "rtc*1 Mrays/s",
                "ratio", "rtc*16 Mrays/s", "mismatch", "edge ties");
     for (const KindResult& r : results) {
       if (!r.embree) {
-        fmt::print("{:<8} {:>8} {:>13.2f}\n", to_string(r.kind), r.rays, r.mrays);
+        fmt::print("{:<13} {:>8} {:>13.2f}\n", to_string(r.kind), r.rays, r.mrays);
         print_kernel_rate(r);
         print_counters(r);
         print_packets(r);
         continue;
       }
-      fmt::print("{:<8} {:>8} {:>13.2f} {:>13.2f} {:>7.2f} {:>13.2f} {:>10} {:>9}\n", to_string(r.kind), r.rays, r.mrays,
+      fmt::print("{:<13} {:>8} {:>13.2f} {:>13.2f} {:>7.2f} {:>13.2f} {:>10} {:>9}\n", to_string(r.kind), r.rays, r.mrays,
                  r.embree_mrays, r.ratio,
                  r.embree->packet_mrays, r.comparison.mismatches(), r.comparison.edge_ties);
       print_kernel_rate(r);

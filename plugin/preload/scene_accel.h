@@ -12,6 +12,7 @@
 
 #include "adapters/embree/embree_geometry.h"
 #include "adapters/out/tracer.h"
+#include "ray_recorder.h"
 
 namespace kmbvh::plugin {
 
@@ -75,7 +76,9 @@ class SceneAccel {
   // of the scene has the default mask, so a ray of mask 0 misses (Debian's Embree is built
   // with ray masks). Returns the hit, found() false on a miss.
   bool trace(const Ray& ray, unsigned ray_mask, Query query, Hit& hit) const {
-    if (ray_mask == 0 || !tracer_) return false;
+    if (ray_mask == 0) return false;
+    if (recording_rays()) record_ray(this, ray, query);
+    if (!tracer_) return false;
     return tracer_->trace_one(ray, query, hit);
   }
 

@@ -1,0 +1,41 @@
+# KMBVH_RECORD_RAYS (cmake -P): the scene client runs under the preload library recording
+# its queries, and `kmbvh trace --rays-file` then traces them with kmbvh and Embree: both
+# query kinds present, as many rays as the limit allowed, no mismatch.
+#   -DCLIENT=kmbvh_scene_client -DPRELOAD=libkmbvh_preload.so -DKMBVH=kmbvh -DSCENE=file|default -DWORK=dir
+file(REMOVE_RECURSE "${WORK}")
+file(MAKE_DIRECTORY "${WORK}")
+set(rays "${WORK}/rays.bin")
+set(limit 3000)
+execute_process(COMMAND ${CMAKE_COMMAND} -E env "LD_PRELOAD=${PRELOAD}" "KMBVH_RECORD_RAYS=${rays}"
+                        "KMBVH_RECORD_LIMIT=${limit}" "${CLIENT}" trace "${SCENE}" "${WORK}/hits.bin"
+                RESULT_VARIABLE rc ERROR_VARIABLE log)
+message("${log}")
+if(NOT rc EQUAL 0 OR NOT log MATCHES "${limit} queries recorded to")
+  message(FATAL_ERROR "the client under the preload failed or recorded no queries (${rc})")
+endif()
+file(SIZE "${rays}" bytes)
+math(EXPR expected "8 + 36 * ${limit}")  # the magic, then one 36-byte record a query
+if(NOT bytes EQUAL expected)
+  message(FATAL_ERROR "${rays}: ${bytes} bytes, expected ${expected}")
+endif()
+execute_process(COMMAND "${KMBVH}" trace "${SCENE}" --rays-file "${rays}" --compare-embree --runs 1 --json --quiet
+                RESULT_VARIABLE rc OUTPUT_VARIABLE out)
+if(NOT rc EQUAL 0)
+  message(FATAL_ERROR "kmbvh trace --rays-file failed (${rc}): ${out}")
+endif()
+string(JSON mismatches GET "${out}" mismatches)
+string(JSON closest GET "${out}" layouts 0 kinds 0 kind)
+string(JSON occlusion GET "${out}" layouts 0 kinds 1 kind)
+string(JSON n0 GET "${out}" layouts 0 kinds 0 rays)
+string(JSON n1 GET "${out}" layouts 0 kinds 1 rays)
+math(EXPR traced "${n0} + ${n1}")
+if(NOT mismatches EQUAL 0 OR NOT closest STREQUAL "app-closest" OR NOT occlusion STREQUAL "app-occlusion"
+   OR NOT traced EQUAL limit)
+  message(FATAL_ERROR "expected ${limit} recorded rays of both kinds traced with no mismatch: ${out}")
+endif()
+# A file that is not a ray file is refused with a message naming it.
+execute_process(COMMAND "${KMBVH}" trace default --rays-file "${CMAKE_CURRENT_LIST_FILE}" --quiet
+                RESULT_VARIABLE rc ERROR_VARIABLE err)
+if(rc EQUAL 0 OR NOT err MATCHES "not a ray file")
+  message(FATAL_ERROR "a file that is not a ray file was not refused (${rc}): ${err}")
+endif()
