@@ -4,8 +4,8 @@
 // a difference is an edge tie, counted apart, when both answers are acceptable (see
 // hit_compare.cpp). Where both hit the same triangle but t, u or v differ, the exact values
 // (double precision) decide: if kmbvh's are right, Embree's float rounding is counted
-// apart; so is a hit or miss of Embree's that a double-precision search over every
-// triangle refutes while it confirms kmbvh's. Everything else is a mismatch.
+// apart; so is a hit, a miss or a triangle of Embree's that a double-precision search over
+// every triangle refutes while it confirms kmbvh's. Everything else is a mismatch.
 #pragma once
 
 #include <cstddef>
