@@ -520,6 +520,7 @@ template <int W, typename Count>
 __attribute__((noinline)) bool traverse_exact(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit,
                                               Count& count, TraversalCounters* counted) {
   count.retrace();
+  hit = Hit();  // nothing of the float descent's candidate stays
   const RaySetup setup(ray);
   const WideRay<W> wray(ray, setup);
   const RayShearExact shear(ray);

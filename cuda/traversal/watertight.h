@@ -118,10 +118,10 @@ KMBVH_HD KMBVH_INLINE bool intersect_watertight_exact(const RayShearExact& s, do
   const double U = cx * by - cy * bx, V = ax * cy - ay * cx, W = bx * ay - by * ax;
   if ((U < 0.0 || V < 0.0 || W < 0.0) && (U > 0.0 || V > 0.0 || W > 0.0)) return false;
   const double det = U + V + W;
-  if (!(det != 0.0)) return false;  // NaN too: a degenerate triangle's layout slot
+  if (det == 0.0) return false;
   const double T = U * (s.sz * A[s.kz]) + V * (s.sz * B[s.kz]) + W * (s.sz * C[s.kz]);
   t = T / det;
-  return t > tnear && t <= tmax;
+  return t > tnear && t <= tmax;  // false for NaN: the vertices of a degenerate triangle's slot
 }
 
 // A triangle's edges from its first vertex, in double precision (exact: each is the
