@@ -11,7 +11,7 @@
 
 namespace kmbvh::plugin {
 
-// Whether KMBVH_RECORD_RAYS is set (read once); the callers skip record() when it is not.
+// Whether KMBVH_RECORD_RAYS is set (read once); the callers skip record_ray() when it is not.
 bool recording_rays();
 
 // Records one query on `scene` (the SceneAccel answering it) if it is the recorded scene

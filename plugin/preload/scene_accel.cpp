@@ -54,7 +54,7 @@ bool SceneAccel::offer(void* user, const Ray&, const Hit& offered) {
 }
 
 void SceneAccel::trace_packet(const Ray* rays, unsigned valid, Query query, Hit* hits) const {
-  if (recording_rays())
+  if (recording_)
     for (unsigned b = valid; b; b &= b - 1) record_ray(this, rays[__builtin_ctz(b)], query);
   if (!tracer_) return;
   try {
@@ -68,7 +68,7 @@ void SceneAccel::trace_packet(const Ray* rays, unsigned valid, Query query, Hit*
 bool SceneAccel::trace_filtered(const Ray& ray, const RTCRay& app_ray, unsigned ray_mask, Query query,
                                 RTCIntersectContext* context, Hit& hit, FilterProbe* probe) const {
   if (ray_mask == 0) return false;
-  if (recording_rays()) record_ray(this, ray, query);
+  if (recording_) record_ray(this, ray, query);
   if (!tracer_) return false;
   Offer offer_data{&filters_, &app_ray, context, query, probe};
   return tracer_->trace_one(ray, query, hit, HitFilter{&SceneAccel::offer, &offer_data});

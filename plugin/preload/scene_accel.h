@@ -77,7 +77,7 @@ class SceneAccel {
   // with ray masks). Returns the hit, found() false on a miss.
   bool trace(const Ray& ray, unsigned ray_mask, Query query, Hit& hit) const {
     if (ray_mask == 0) return false;
-    if (recording_rays()) record_ray(this, ray, query);
+    if (recording_) record_ray(this, ray, query);
     if (!tracer_) return false;
     return tracer_->trace_one(ray, query, hit);
   }
@@ -96,6 +96,7 @@ class SceneAccel {
   std::unique_ptr<AccelGeometry> geometry_;
   std::vector<GeometryFilters> filters_;
   bool intersect_filters_ = false, occluded_filters_ = false;
+  const bool recording_ = recording_rays();  // KMBVH_RECORD_RAYS, read once: no call per query
 };
 
 }  // namespace kmbvh::plugin
