@@ -108,12 +108,13 @@ inline vfk sheared_component(const PacketShear& r, int j, const float* x, const 
 // intersect_pack for the rays `active` at once, SIMD over the rays (one triangle of the
 // pack at a time), in the same operations on the same values lane by lane, so each ray
 // gets the masks and t it would get alone; then each ray's candidates are confirmed by
-// confirm_hits, as alone. Calls `found(i, slot, t, check, bound)` for each ray with a
-// candidate.
+// confirm_hits, as alone. Calls `found(i, slot, candidate)` for each ray with a
+// candidate. `reach`: each ray's Search::cull.
 template <Query query, Confirm confirm, typename Count, typename Found>
 __attribute__((always_inline)) inline void intersect_pack_rays(const TrianglePack& p, const PacketShear& r,
                                                               const PackRay* pack_rays, const Ray* rays,
-                                                              const Search* search, vfk reach, unsigned active,
+                                                              const TrianglePack* packs, Search* search, vfk reach,
+                                                              unsigned active,
                                                               Count& count, const Found& found) {
   const vik on = lanes_of(active);
   unsigned hits[kPackWidth], redo[kPackWidth], any = 0;
@@ -142,16 +143,12 @@ __attribute__((always_inline)) inline void intersect_pack_rays(const TrianglePac
       z |= (redo[slot] >> i & 1) << slot;
       if ((hits[slot] | redo[slot]) >> i & 1) t[slot] = ts[slot][i];
     }
-    float t_hit;
-    ExactCheck check;
-    float bound = 0.0f;
-    const int slot =
-        query == Query::Any
-            ? confirm_hits<query, confirm>(p, pack_rays[i], rays[i].tnear, search[i].tmax, search[i].reach,
-                                           search[i].found_key, t, h, z, t_hit, check, bound, count)
-            : confirm_hits_apart<query, confirm>(p, pack_rays[i], rays[i].tnear, search[i].tmax, search[i].reach,
-                                                 search[i].found_key, t, h, z, t_hit, check, bound, count);
-    if (slot >= 0) found(i, slot, t_hit, check, bound);
+    Candidate c;
+    const int slot = query == Query::Any
+                         ? confirm_hits<query, confirm>(p, packs, pack_rays[i], rays[i].tnear, search[i], t, h, z, c, count)
+                         : confirm_hits_apart<query, confirm>(p, packs, pack_rays[i], rays[i].tnear, search[i], t, h, z,
+                                                              c, count);
+    if (slot >= 0) found(i, slot, c);
   }
 }
 
@@ -251,7 +248,6 @@ void traverse_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Hit
   pr.tnear = vf(lanes.tnear);
   shear.sx = vf(lanes.sx), shear.sy = vf(lanes.sy), shear.sz = vf(lanes.sz), shear.tnear = vf(lanes.shear_tnear);
   vfk cull = vf(lanes.cull);  // each ray's Search::cull (-inf: not searching)
-  vfk reach = vf(lanes.cull);  // and its Search::reach (tfar while nothing is found)
   if (!alive) return;
   // The nearest candidate's hit for the rays that answer closest-hit queries, or the
   // occluder for the occlusion rays that found one.
@@ -263,7 +259,7 @@ void traverse_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Hit
                                           count))
       alive &= ~(1u << i), answered |= 1u << i, cull[i] = -std::numeric_limits<float>::infinity();
     else
-      cull[i] = search[i].cull, reach[i] = search[i].reach;
+      cull[i] = search[i].cull;
   };
   uint32_t sp = 0;
   PacketEntry cur{pr.tnear, 0, 0, alive};
@@ -305,37 +301,31 @@ void traverse_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Hit
       for (uint32_t p = cur.ref, end = cur.ref + (cur.count + kPackWidth - 1) / kPackWidth; p < end; ++p) {
         const TrianglePack& pack = bvh.packs[p];
         // Ray i's candidate `slot` of this pack, as the single-ray descent takes it.
-        auto take = [&](unsigned i, int slot, float t, const ExactCheck& e, float bound) {
+        auto take = [&](unsigned i, int slot, const Candidate& c) {
           Search& s = search[i];
-          s.found = p * kPackWidth + uint32_t(slot);
-          s.found_key = tie_key(pack.id[slot]);
-          s.check = e;
-          s.found_bound = bound;
-          hits[i].t = t;
+          s.take(p * kPackWidth + uint32_t(slot), tie_key(pack.id[slot]), c);
+          hits[i].t = c.t;
           if (query == Query::Any) {
             finish_hit(bvh, s.found, s.check, hits[i], false);
             alive &= ~(1u << i), answered |= 1u << i, cull[i] = -std::numeric_limits<float>::infinity();
           } else {
-            s.narrow(t);
             cull[i] = s.cull;
-            reach[i] = s.reach;
           }
         };
         const unsigned in = cur.rays & alive;
         const uint32_t triangles = std::min<uint32_t>(kPackWidth, cur.count - (p - cur.ref) * kPackWidth);
         for (unsigned b = in; b; b &= b - 1) count.pack(triangles);
         if (unsigned(__builtin_popcount(in)) >= kRaysForPacketLeaf) {
-          intersect_pack_rays<query, confirm>(pack, shear, pack_rays, rays, search, reach, in, count, take);
+          intersect_pack_rays<query, confirm>(pack, shear, pack_rays, rays, bvh.packs.data(), search, cull, in, count,
+                                              take);
           continue;
         }
         for (unsigned b = in; b; b &= b - 1) {
           const unsigned i = __builtin_ctz(b);
-          float t;
-          ExactCheck e;
-          float bound = 0.0f;
+          Candidate c;
           const int slot =
-              intersect_pack<query, confirm>(pack, pack_rays[i], rays[i].tnear, search[i], t, e, bound, count);
-          if (slot >= 0) take(i, slot, t, e, bound);
+              intersect_pack<query, confirm>(pack, bvh.packs.data(), pack_rays[i], rays[i].tnear, search[i], c, count);
+          if (slot >= 0) take(i, slot, c);
         }
       }
     }

@@ -190,80 +190,120 @@ inline Vec3 slot_vertex(const TrianglePack& p, int v, uint32_t slot) {
 //   the ones later beaten are never measured; the answer is the same (see traverse).
 enum class Confirm { Exact, Interval, Deferred };
 
-// Candidates at one distance are taken in the order of their ids, the lower (geomID, primID)
-// first, so that the closest hit among coincident triangles (a two-sided wall, a mesh
-// duplicated in place) does not depend on the order the traversal meets them in: the
-// packet traversal meets them in another order than a single ray does.
+// Candidates at one exact distance are taken in the order of their ids, the lower
+// (geomID, primID) first, so that the closest hit among coincident triangles (a two-sided
+// wall, a mesh duplicated in place) does not depend on the order the traversal meets them
+// in: the packet traversal meets them in another order than a single ray does.
 inline uint64_t tie_key(PrimitiveId id) { return uint64_t(id.geom) << 32 | id.prim; }
 constexpr uint64_t kNoCandidate = ~uint64_t(0);  // no triangle has kInvalidId for both ids
 
-// How far past the closest candidate's t the pack test looks once there is one: a triangle
-// at the very same t then passes its scaled interval test (|T| <= tmax |det|) whatever the
-// roundings (2^-21 of t, 4 to 8 ulp), and the order is decided on the candidates' t and ids.
-inline float tie_reach(float t) { return t * (1.0f + 0x1p-21f); }  // t > tnear >= 0 (ray_is_valid)
-
-// The boxes a ray enters once it has a candidate at t: those it enters before t, and a
-// little beyond (2^-14 of t). A triangle's float t is off by a few ulp, and on large
-// triangles far from the origin by more; a coincident triangle at the same exact t whose
-// box the ray enters just after the candidate's float t must still be met, or which of the
-// two is the closest hit would depend on which the traversal met first (tie_key). (One
-// multiplication each, so a new candidate delays the next box test the least.)
-inline float cull_reach(float t) { return t * (1.0f + 0x1p-14f); }
+// How far past the closest candidate's float t the search still looks: 2^-13 of t. The
+// float watertight test's t is off by a few ulp on most triangles, but on a long thin
+// triangle far from the origin by far more: its sheared edge functions cancel, and the
+// error in t grows with the square of the vertices' distance over the triangle's area
+// (conference's ceiling trims, 955 units long and 2 wide, 300 units away: 4.3e-5 of t,
+// found by the A/B mode in Embree's pathtracer; docs/design.md §8). Two candidates within
+// that reach of each other are therefore ordered by their exact t (near, confirm_hits), and
+// a candidate's box and triangle are tested up to it, so that the nearer of two is met
+// whichever comes first, for float errors up to half the reach. (One multiplication, so a
+// new candidate delays the next box test the least.)
+inline float cull_reach(float t) { return t * (1.0f + 0x1p-13f); }
+// Whether float distances a and b are within each other's reach, too close to order by.
+inline bool near(float a, float b) { return a <= cull_reach(b) && b <= cull_reach(a); }
 // A stack entry is popped up to cull_reach(t) * kRobustExit, the box test's reach (at
 // least: the constant rounds up), in one multiplication off the ray's critical path.
-constexpr float kPopReach = 1.0f + 0x1p-14f + 0x1p-19f;
-static_assert(kPopReach >= (1.0f + 0x1p-14f) * kRobustExit, "a popped entry must reach as far as the box test");
+constexpr float kPopReach = 1.0f + 0x1p-13f + 0x1p-19f;
+static_assert(kPopReach >= (1.0f + 0x1p-13f) * kRobustExit, "a popped entry must reach as far as the box test");
+
+// The exact distance to a pack's slot (exact_distance), NaN when parallel.
+inline double slot_exact_distance(const Ray& ray, const TrianglePack& p, uint32_t slot) {
+  return exact_distance(ray, slot_vertex(p, 0, slot), slot_vertex(p, 1, slot), slot_vertex(p, 2, slot));
+}
+constexpr double kUnmeasured = __builtin_nan("");
+
+// What confirm_hits says of the slot it chooses.
+struct Candidate {
+  float t = 0.0f;              // its float t
+  ExactCheck check;            // its exact check (Confirm::Exact)
+  float bound = 0.0f;          // the end of the interval it was accepted in (Confirm::Deferred)
+  double exact = kUnmeasured;  // its exact t, when a near candidate needed it
+};
 
 // A ray's search as it stands, carried from one descent to the next (the packet traversal
 // hands it to the single-ray descent and back).
 struct Search {
   float tmax;                   // the interval's end: tfar, then the closest candidate's t
-  float reach;                  // how far the pack test looks: tmax, then tie_reach(tmax)
-  float cull;                   // how far the box tests look: tmax, then cull_reach(tmax)
+  float cull;                   // how far the box and pack tests look: tmax, then cull_reach(tmax)
   float pop;                    // and a stack entry: cull widened as the box test widens exits
   uint32_t found = kInvalidId;  // the closest candidate's triangle
   uint64_t found_key = kNoCandidate;  // and its tie_key
+  double found_exact = kUnmeasured;   // and its exact t, once a near candidate needed it
   ExactCheck check;             // and its exact check (Confirm::Exact)
   float found_bound = 0.0f;     // or the end of the interval it was accepted in (Confirm::Deferred)
 
-  explicit Search(float tfar) : tmax(tfar), reach(tfar), cull(tfar), pop(tfar * kRobustExit) {}
+  explicit Search(float tfar) : tmax(tfar), cull(tfar), pop(tfar * kRobustExit) {}
   Search() = default;
-  // A closer candidate was found at t.
-  void narrow(float t) {
-    tmax = t;
-    reach = tie_reach(t);
-    cull = cull_reach(t);
-    pop = t * kPopReach;
+  // Triangle `triangle` (its tie_key `key`) is the closest candidate now.
+  void take(uint32_t triangle, uint64_t key, const Candidate& c) {
+    found = triangle;
+    found_key = key;
+    found_exact = c.exact;
+    check = c.check;
+    found_bound = c.bound;
+    tmax = c.t;
+    cull = cull_reach(c.t);
+    pop = c.t * kPopReach;
   }
 };
 
 // The candidates of a pack's test, confirmed one by one (Confirm): `hits`, the slots the
 // vector test accepted, with their t; `redo`, those whose edge functions came out exactly
 // zero, for the scalar test. A slot counts if it beats the closest candidate so far (the
-// search's, then this pack's best): nearer, or as near with a lower tie_key. `bound`: with
-// Deferred, the end of the interval the chosen slot was accepted in (tmax, or an earlier
-// slot's t), for its check.
+// search's, then this pack's best): nearer by float t, or, when the two are near, nearer
+// by exact t, or as near with a lower tie_key. The chosen slot's details go to `c` (with
+// Deferred, its bound is the end of the interval it was accepted in: tmax, or an earlier
+// slot's t). `packs`: the layout's, where the search's candidate is measured when a near
+// slot needs its exact t.
 template <Query query, Confirm confirm, typename Count>
-__attribute__((always_inline)) inline int confirm_hits(const TrianglePack& p, const PackRay& r, float tnear,
-                                                       float tmax, float reach, uint64_t prior_key, vfp t,
-                                                       unsigned hits, unsigned redo, float& t_hit, ExactCheck& check,
-                                                       float& bound, Count& count) {
+__attribute__((always_inline)) inline int confirm_hits(const TrianglePack& p, const TrianglePack* packs,
+                                                       const PackRay& r, float tnear, Search& s, vfp t,
+                                                       unsigned hits, unsigned redo, Candidate& c, Count& count) {
   auto vertex = [&](int v, int slot) { return slot_vertex(p, v, uint32_t(slot)); };
-  const bool prior = prior_key != kNoCandidate;
+  const bool prior = s.found_key != kNoCandidate;
   int best = -1;
+  float& t_hit = c.t;
+  double& exact = c.exact;
+  exact = kUnmeasured;
+  double slot_exact = kUnmeasured;  // the exact t of the slot `beats` last measured
   auto beats = [&](int slot, float ts) {
+    slot_exact = kUnmeasured;
     if (best < 0 && !prior) return true;  // the test admitted it within (tnear, tfar]
-    const float tb = best < 0 ? tmax : t_hit;
+    const float tb = best < 0 ? s.tmax : t_hit;
+    const uint64_t kb = best < 0 ? s.found_key : tie_key(p.id[best]);
+    if (near(ts, tb)) {
+      double& eb = best < 0 ? s.found_exact : exact;
+      if (eb != eb) {
+        count.exact();
+        eb = best < 0 ? slot_exact_distance(r.ray, packs[s.found / kPackWidth], s.found % kPackWidth)
+                      : slot_exact_distance(r.ray, p, uint32_t(best));
+      }
+      count.exact();
+      slot_exact = slot_exact_distance(r.ray, p, uint32_t(slot));
+      if (slot_exact == slot_exact && eb == eb) {
+        if (slot_exact != eb) return slot_exact < eb;
+        return tie_key(p.id[slot]) < kb;
+      }
+    }
     if (ts != tb) return ts < tb;
-    return tie_key(p.id[slot]) < (best < 0 ? prior_key : tie_key(p.id[best]));
+    return tie_key(p.id[slot]) < kb;
   };
   // Whether `slot` counts; for Exact and Interval, measured against (tnear, end]: tfar for
   // the first candidate, then a little past the closest one's float t (cull_reach), which
   // may be an ulp below the exact t of both when they are coincident.
   auto accept = [&](int slot) {
-    const float end = best < 0 ? (prior ? cull_reach(tmax) : tmax) : cull_reach(t_hit);
+    const float end = best < 0 ? (prior ? cull_reach(s.tmax) : s.tmax) : cull_reach(t_hit);
     if constexpr (confirm == Confirm::Deferred) {
-      bound = end;
+      c.bound = end;
       return true;
     } else if constexpr (confirm == Confirm::Interval) {
       count.exact();
@@ -271,7 +311,7 @@ __attribute__((always_inline)) inline int confirm_hits(const TrianglePack& p, co
     } else {
       count.exact();
       const ExactCheck e = exact_check(r.ray, vertex(0, slot), vertex(1, slot), vertex(2, slot), tnear, end);
-      if (e.within) check = e;
+      if (e.within) c.check = e;
       return e.within;
     }
   };
@@ -279,17 +319,17 @@ __attribute__((always_inline)) inline int confirm_hits(const TrianglePack& p, co
     const int slot = __builtin_ctz(hits);
     if (!beats(slot, t[slot])) continue;
     if (!accept(slot)) continue;
-    best = slot, t_hit = t[slot];
+    best = slot, t_hit = t[slot], exact = slot_exact;
     if (query == Query::Any) return best;
   }
   for (; redo; redo &= redo - 1) {
     const int slot = __builtin_ctz(redo);
     Hit h;
-    const float end = best < 0 ? reach : tie_reach(t_hit);
+    const float end = best < 0 ? s.cull : cull_reach(t_hit);
     if (!intersect_watertight(r.shear, tnear, end, vertex(0, slot), vertex(1, slot), vertex(2, slot), h)) continue;
     if (!beats(slot, h.t)) continue;
     if (!accept(slot)) continue;
-    best = slot, t_hit = h.t;
+    best = slot, t_hit = h.t, exact = slot_exact;
     if (query == Query::Any) return best;
   }
   return best;
@@ -299,10 +339,10 @@ __attribute__((always_inline)) inline int confirm_hits(const TrianglePack& p, co
 // keeps its registers; inline for occlusion, whose first confirmed hit ends the ray (the
 // faster of the two for each, measured).
 template <Query query, Confirm confirm, typename Count>
-__attribute__((noinline)) int confirm_hits_apart(const TrianglePack& p, const PackRay& r, float tnear, float tmax,
-                                                 float reach, uint64_t prior_key, vfp t, unsigned hits, unsigned redo,
-                                                 float& t_hit, ExactCheck& check, float& bound, Count& count) {
-  return confirm_hits<query, confirm>(p, r, tnear, tmax, reach, prior_key, t, hits, redo, t_hit, check, bound, count);
+__attribute__((noinline)) int confirm_hits_apart(const TrianglePack& p, const TrianglePack* packs, const PackRay& r,
+                                                 float tnear, Search& s, vfp t, unsigned hits, unsigned redo,
+                                                 Candidate& c, Count& count) {
+  return confirm_hits<query, confirm>(p, packs, r, tnear, s, t, hits, redo, c, count);
 }
 
 // The watertight test's decision, lane by lane, from the vertices sheared into the ray's
@@ -337,16 +377,15 @@ __attribute__((always_inline)) inline WatertightLanes<VF, VM> watertight_lanes(c
 
 // The watertight test (cuda/traversal/watertight.h) on a pack of triangles at once, in the
 // same operations as the scalar test. Returns the slot of the nearest hit in (tnear,
-// search.tmax] that beats the search's candidate (confirm_hits), its float t and its exact
-// check, or -1; for Query::Any, the first slot found to
-// be hit, since any one will do. A slot whose edge functions come out exactly zero goes
-// to the scalar test, which redoes them in double precision.
-// `skip`: slots a hit filter has already turned down for this ray (0 without a filter).
-// `check` and `bound`: as confirm_hits gives them.
+// search.cull] that beats the search's candidate (confirm_hits: its details in `c`), or -1;
+// for Query::Any, the first slot found to be hit, since any one will do. A slot whose edge
+// functions come out exactly zero goes to the scalar test, which redoes them in double
+// precision. `skip`: slots a hit filter has already turned down for this ray (0 without a
+// filter).
 template <Query query, Confirm confirm, typename Count>
-__attribute__((always_inline)) inline int intersect_pack(const TrianglePack& p, const PackRay& r, float tnear,
-                                                         const Search& search, float& t_hit, ExactCheck& check,
-                                                         float& bound, Count& count, unsigned skip = 0) {
+__attribute__((always_inline)) inline int intersect_pack(const TrianglePack& p, const TrianglePack* packs,
+                                                         const PackRay& r, float tnear, Search& search, Candidate& c,
+                                                         Count& count, unsigned skip = 0) {
   const RayShear& s = r.shear;
   vfp x[3], y[3], z[3];
   for (int v = 0; v < 3; ++v) {
@@ -355,16 +394,14 @@ __attribute__((always_inline)) inline int intersect_pack(const TrianglePack& p, 
     x[v] = dx - r.sx * z[v];
     y[v] = dy - r.sy * z[v];
   }
-  const WatertightLanes<vfp, vip> w = watertight_lanes<vfp, vip>(x, y, z, r.sz, r.tnear, splat<vfp>(search.reach));
+  const WatertightLanes<vfp, vip> w = watertight_lanes<vfp, vip>(x, y, z, r.sz, r.tnear, splat<vfp>(search.cull));
   const unsigned hits = mask_bits(w.valid & ~w.exact_zero) & ~skip;
   const unsigned redo = mask_bits(w.exact_zero) & ~skip;
   if (!(hits | redo)) return -1;
   if constexpr (query == Query::Any)
-    return confirm_hits<query, confirm>(p, r, tnear, search.tmax, search.reach, search.found_key, w.T / w.det, hits,
-                                        redo, t_hit, check, bound, count);
+    return confirm_hits<query, confirm>(p, packs, r, tnear, search, w.T / w.det, hits, redo, c, count);
   else
-    return confirm_hits_apart<query, confirm>(p, r, tnear, search.tmax, search.reach, search.found_key, w.T / w.det,
-                                              hits, redo, t_hit, check, bound, count);
+    return confirm_hits_apart<query, confirm>(p, packs, r, tnear, search, w.T / w.det, hits, redo, c, count);
 }
 
 // Completes the hit on triangle `found` (hit.t is set): its ids, and unless `refine` is
@@ -462,44 +499,36 @@ __attribute__((always_inline)) inline bool descend(const WideBvh<W>& bvh, const 
       continue;
     }
     for (uint32_t p = cur.ref, end = cur.ref + (cur.count + kPackWidth - 1) / kPackWidth; p < end; ++p) {
-      float t;
       count.pack(std::min<uint32_t>(kPackWidth, cur.count - (p - cur.ref) * kPackWidth));
       if (!Filtered) {
-        ExactCheck e;
-        float bound = 0.0f;
-        const int slot = intersect_pack<query, confirm>(bvh.packs[p], pack_ray, ray.tnear, s, t, e, bound, count);
+        Candidate c;
+        const int slot =
+            intersect_pack<query, confirm>(bvh.packs[p], bvh.packs.data(), pack_ray, ray.tnear, s, c, count);
         if (slot < 0) continue;
-        s.found = p * kPackWidth + uint32_t(slot);
-        s.found_key = tie_key(bvh.packs[p].id[slot]);
-        s.check = e;
-        s.found_bound = bound;
-        hit.t = t;
+        s.take(p * kPackWidth + uint32_t(slot), tie_key(bvh.packs[p].id[slot]), c);
+        hit.t = c.t;
         if (query == Query::Any) return finish_hit(bvh, s.found, s.check, hit, false);
-        s.narrow(t);
         continue;
       }
       // For the closest hit, the pack's nearest slot first; for occlusion, the first slot
       // found to be hit (Embree offers occlusion candidates in no particular order). One
       // the filter refuses is skipped and the next tried.
       for (unsigned skip = 0;;) {
-        ExactCheck e;
-        float bound = 0.0f;
+        Candidate c;
         const int slot =
-            intersect_pack<query, confirm>(bvh.packs[p], pack_ray, ray.tnear, s, t, e, bound, count, skip);
+            intersect_pack<query, confirm>(bvh.packs[p], bvh.packs.data(), pack_ray, ray.tnear, s, c, count, skip);
         if (slot < 0) break;
         const uint32_t candidate = p * kPackWidth + uint32_t(slot);
         Hit offered;
-        offered.t = t;
-        finish_hit(bvh, candidate, e, offered);
+        offered.t = c.t;
+        finish_hit(bvh, candidate, c.check, offered);
         if (!filter->accept(filter->user, ray, offered)) {
           skip |= 1u << slot;
           continue;
         }
         hit = offered;
         if (query == Query::Any) return true;
-        s.found = candidate;
-        s.found_key = tie_key(bvh.packs[p].id[slot]);
-        s.narrow(t);
+        s.take(candidate, tie_key(bvh.packs[p].id[slot]), c);
         break;  // the pack's other slots are farther
       }
     }
