@@ -612,6 +612,18 @@ inline bool outside_by_exact_check(const ExactCheck& e) {
   return e.measured && (u < -kOutside || v < -kOutside || 1.0 - u - v < -kOutside);
 }
 
+// Whether the closest candidate's float t (t) lies within 2^-14 of its exact t (e), half
+// of cull_reach: what ordering near candidates by exact t assumes of every candidate. The
+// float t of a thin triangle whose vertices are far from the origin compared with its
+// distance is off by more (sponza's 11-unit trims seen from 0.026 away: 1%), and a nearer
+// triangle's, as far off, may have put it past the search's reach. Such a ray's answer is
+// decided again in double precision. (Checking the candidate found catches the neighbours
+// of a strip, which share its conditioning; a lone triangle far worse conditioned than the
+// one found is not caught. Retraces 0.0x% of the pathtracer's rays: docs/design.md §8.)
+inline bool distance_trusted(float t, const ExactCheck& e) {
+  return !e.measured || std::fabs(t - e.t) <= e.t * 0x1p-14f;
+}
+
 // The answer once every descent is over: with Deferred, the closest candidate's exact check
 // over the interval it was accepted in (a failed one traces the ray again with Exact, a
 // doubtful one with traverse_exact); then its hit completed.
@@ -625,7 +637,8 @@ __attribute__((always_inline)) inline bool conclude(const WideBvh<W>& bvh, const
       count.exact();
       s.check = exact_check(ray, slot_vertex(p, 0, slot), slot_vertex(p, 1, slot), slot_vertex(p, 2, slot),
                             ray.tnear, s.found_bound);
-      if (outside_by_exact_check(s.check)) return traverse_exact<W>(bvh, ray, stack, hit, count, counted);
+      if (outside_by_exact_check(s.check) || !distance_trusted(s.tmax, s.check))
+        return traverse_exact<W>(bvh, ray, stack, hit, count, counted);
       if (!s.check.within)  // a needle's float t was off: once more, every candidate checked
         return traverse<W, query, false, Count, Confirm::Exact>(bvh, ray, stack, hit, nullptr, count, counted);
     }
