@@ -99,15 +99,20 @@ struct RaySetup {
 
 // Per-ray constants of the slab test, broadcast to every lane; the near and far planes of
 // each axis as offsets into a node's lo/hi arrays, chosen once by the direction's signs.
+// The exit distances are widened by kRobustExit (ray_box.h) through the reciprocals they
+// are measured with (inv_exit): a far plane's t is then larger in magnitude by the factor,
+// less the one rounding of the product, which the factor's margin over 1 + 2 gamma(3)
+// covers; the widening is off the node test's chain of dependent operations.
 template <int W>
 struct WideRay {
   using V = typename Lanes<W>::V;
-  V org[3], inv[3], tnear;
+  V org[3], inv[3], inv_exit[3], tnear;
   int near_plane[3], far_plane[3];
   __attribute__((always_inline)) WideRay(const Ray& ray, const RaySetup& s) {
     for (int d = 0; d < 3; ++d) {
       org[d] = splat<V>(ray.org[d]);
       inv[d] = splat<V>(s.inv[d]);
+      inv_exit[d] = splat<V>(s.inv[d] * kRobustExit);
       const bool near_hi = s.inv[d] < 0.0f;
       near_plane[d] = (near_hi ? 3 * W : 0) + d * W;  // hi follows lo in WideNode
       far_plane[d] = (near_hi ? 0 : 3 * W) + d * W;
@@ -120,13 +125,13 @@ template <int W>
 inline unsigned enter_children(const WideNode<W>& n, const WideRay<W>& r, float tmax, typename Lanes<W>::V& entry) {
   using V = typename Lanes<W>::V;
   const float* planes = &n.lo[0][0];
-  V t0 = r.tnear, t1 = splat<V>(tmax);
+  V t0 = r.tnear, t1 = splat<V>(tmax * kRobustExit);
   for (int d = 0; d < 3; ++d) {
     t0 = vmax(t0, (load<W>(planes + r.near_plane[d]) - r.org[d]) * r.inv[d]);
-    t1 = vmin(t1, (load<W>(planes + r.far_plane[d]) - r.org[d]) * r.inv[d]);
+    t1 = vmin(t1, (load<W>(planes + r.far_plane[d]) - r.org[d]) * r.inv_exit[d]);
   }
   entry = t0;
-  return mask_bits(t0 <= t1 * kRobustExit);
+  return mask_bits(t0 <= t1);
 }
 
 // Starts fetching the first two lines of what a child entered or pushed will read (an
