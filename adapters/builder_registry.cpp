@@ -95,11 +95,12 @@ BuilderConfig parse_builder(const std::string& spec) {
   const std::optional<BuilderKind> kind = builder_kind(name);
   if (!kind)
     throw std::invalid_argument(fmt::format(
-        "unknown builder '{}' (sweep-sah, lbvh, hlbvh, atrbvh, ploc, kmeans, Q1..Q5, QA, embree-low|medium|high)", spec));
+        "unknown builder '{}' (sweep-sah, lbvh, hlbvh, atrbvh, ploc, kmeans, Q1..Q5, QA, Q1S..Q5S, QAS, "
+        "embree-low|medium|high)", spec));
   config.builder = *kind;
   if (*kind == BuilderKind::Kmeans) {
     const auto params = kmeans_preset(preset);
-    if (!params) throw std::invalid_argument(fmt::format("unknown k-means preset '{}' (Q1 to Q5, QA)", preset));
+    if (!params) throw std::invalid_argument(fmt::format("unknown k-means preset '{}' (Q1 to Q5, QA, each of them followed by S)", preset));
     config.kmeans = *params;
     config.preset = preset;
     for (char& c : config.preset) c = char(std::toupper(static_cast<unsigned char>(c)));
@@ -111,8 +112,8 @@ BuilderConfig parse_builder(const std::string& spec) {
 
 std::vector<BuilderConfig> all_builders() {
   std::vector<BuilderConfig> all;
-  for (const char* spec : {"sweep-sah", "lbvh", "hlbvh", "atrbvh", "ploc", "Q1", "Q2", "Q3", "Q4", "Q5", "QA", "embree-low",
-                           "embree-medium", "embree-high"})
+  for (const char* spec : {"sweep-sah", "lbvh", "hlbvh", "atrbvh", "ploc", "Q1", "Q2", "Q3", "Q4", "Q5", "QA", "Q1S", "Q3S",
+                           "QAS", "embree-low", "embree-medium", "embree-high"})
     all.push_back(parse_builder(spec));
   return all;
 }

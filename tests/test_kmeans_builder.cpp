@@ -87,7 +87,7 @@ TEST_P(EveryPreset, CpuSubtreePathBuildsTheLevelLoopsTree) {
       }
 }
 
-INSTANTIATE_TEST_SUITE_P(KMeans, EveryPreset, ::testing::Values("Q1", "Q2", "Q3", "Q4", "Q5", "QA"));
+INSTANTIATE_TEST_SUITE_P(KMeans, EveryPreset, ::testing::Values("Q1", "Q2", "Q3", "Q4", "Q5", "QA", "Q1S", "Q3S", "QAS"));
 
 TEST(KMeansBuilder, FreeParameters) {
   const PrimitiveSet prims = make_primitive_set(test::random_triangles(5000, 4));
@@ -234,7 +234,7 @@ TEST_P(Degenerate, SharedCentroidAndZeroArea) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(KMeans, Degenerate, ::testing::Values("Q1", "Q2", "Q3", "Q4", "Q5", "QA"));
+INSTANTIATE_TEST_SUITE_P(KMeans, Degenerate, ::testing::Values("Q1", "Q2", "Q3", "Q4", "Q5", "QA", "Q3S"));
 
 }  // namespace
 }  // namespace kmbvh

@@ -1,16 +1,39 @@
 #include "kmeans_builder.h"
 
+#include <algorithm>
+#include <chrono>
 #include <stdexcept>
 
+#include "../core/sah_leaves.h"
+
 namespace kmbvh {
+namespace {
+
+Bvh build_on(Backend backend, const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info) {
+#if defined(KMBVH_HAS_CUDA)
+  if (backend == Backend::Cuda) return detail::build_kmeans_gpu(prims, params, info);
+#else
+  (void)backend;
+#endif
+  return detail::build_kmeans_cpu(prims, params, info);
+}
+
+}  // namespace
 
 Bvh build_kmeans(const PrimitiveSet& prims, const KMeansParams& params, Backend backend, BuildInfo* info) {
   if (const std::string problem = check_params(params); !problem.empty()) throw std::invalid_argument(problem);
   require_backend(backend);
-#if defined(KMBVH_HAS_CUDA)
-  if (backend == Backend::Cuda) return detail::build_kmeans_gpu(prims, params, info);
-#endif
-  return detail::build_kmeans_cpu(prims, params, info);
+  if (!params.sah_leaves) return build_on(backend, prims, params, info);
+  // SAH leaves: the clusters go down to a few primitives, then the SAH picks the leaves.
+  KMeansParams fine = params;
+  fine.max_leaf_size = std::min(params.max_leaf_size, KMeansParams::kSahLeafCluster);
+  const Bvh clustered = build_on(backend, prims, fine, info);
+  const auto start = std::chrono::steady_clock::now();
+  Bvh bvh = collapse_leaves_by_sah(clustered, params.max_leaf_size);
+  if (info)
+    info->add_phase("sah leaves",
+                    std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
+  return bvh;
 }
 
 }  // namespace kmbvh

@@ -17,7 +17,8 @@ constexpr Preset kPresets[] = {
     {"Q1", 8, 5, 0, false},   {"Q2", 8, 5, 2, false},   {"Q3", 16, 5, 5, false},
     {"Q4", 32, 20, 10, false}, {"Q5", 64, 30, 15, false}, {"QA", 64, 30, 15, true},
 };
-constexpr const char* kNames[] = {"Q1", "Q2", "Q3", "Q4", "Q5", "QA", nullptr};
+constexpr const char* kNames[] = {"Q1",  "Q2",  "Q3",  "Q4",  "Q5",  "QA",
+                                  "Q1S", "Q2S", "Q3S", "Q4S", "Q5S", "QAS", nullptr};
 
 std::string upper(std::string s) {
   for (char& c : s) c = char(std::toupper(static_cast<unsigned char>(c)));
@@ -27,10 +28,13 @@ std::string upper(std::string s) {
 }  // namespace
 
 std::optional<KMeansParams> kmeans_preset(const std::string& name) {
-  const std::string wanted = upper(name);
+  std::string wanted = upper(name);
+  const bool sah_leaves = wanted.size() == 3 && wanted.back() == 'S';
+  if (sah_leaves) wanted.pop_back();
   for (const Preset& preset : kPresets) {
     if (wanted != preset.name) continue;
     KMeansParams params;
+    params.sah_leaves = sah_leaves;
     params.k = preset.k;
     params.p = preset.p;
     params.i = preset.i;

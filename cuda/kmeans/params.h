@@ -32,6 +32,15 @@ struct KMeansParams {
   // depth-first (subtree_cpu.h). The tree is the same either way; false runs every level
   // through the portable level loop, as the GPU does.
   bool cpu_subtrees = true;
+  // Leaves chosen by SAH (a configuration beyond the paper): cluster down to at most
+  // kSahLeafCluster primitives, then make each subtree of at most m primitives a leaf where
+  // the SAH prefers it (cuda/core/sah_leaves.h). false: the paper's rule, every cluster of
+  // at most m primitives is a leaf.
+  bool sah_leaves = false;
+  // Measured on conference: the SAH keeps leaves of one to three primitives; clustering
+  // down to three gives the tree clustering down to one does, in half the time, and four
+  // already leaves a third more triangles per ray (docs/results.md).
+  static constexpr uint32_t kSahLeafCluster = 3;
 
   static constexpr uint32_t kMaxK = 64;  // local arrays in the kernels are sized by this
 };
@@ -39,7 +48,7 @@ struct KMeansParams {
 // "Q1".."Q5" (case-insensitive), as in the paper's Table 1, and "QA", the adaptive preset:
 // k, p and the iteration cap per node (k up to 64, p up to 30, at most 15 iterations and
 // fewer for larger k), each node's Lloyd loop stopped once it moves at most 2% of its
-// primitives (node_rules.h).
+// primitives (node_rules.h). Each followed by S ("Q3S") is the same with SAH leaves.
 std::optional<KMeansParams> kmeans_preset(const std::string& name);
 const char* const* kmeans_preset_names();  // null-terminated list
 std::string to_string(ClusterMetric metric);

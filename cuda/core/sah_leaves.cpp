@@ -1,0 +1,71 @@
+#include "sah_leaves.h"
+
+#include <vector>
+
+namespace kmbvh {
+namespace {
+
+// Appends the primitives under `node` to `out`, depth first.
+void gather(const Bvh& bvh, uint32_t node, std::vector<uint32_t>& out) {
+  const BvhNode& n = bvh.nodes[node];
+  if (n.is_leaf()) {
+    out.insert(out.end(), bvh.prim_indices.begin() + n.first, bvh.prim_indices.begin() + n.first + n.count);
+    return;
+  }
+  for (uint32_t c = 0; c < n.count; ++c) gather(bvh, n.first + c, out);
+}
+
+}  // namespace
+
+Bvh collapse_leaves_by_sah(const Bvh& bvh, uint32_t max_leaf_size, const SahLeafCosts& costs) {
+  if (bvh.empty()) return bvh;
+  const size_t n = bvh.nodes.size();
+  std::vector<uint32_t> count(n);
+  std::vector<float> cost(n);
+  std::vector<uint8_t> as_leaf(n);
+  // Children come after their parents (bvh.h): from the back, every child is priced first.
+  for (size_t i = n; i-- > 0;) {
+    const BvhNode& node = bvh.nodes[i];
+    const float area = node.box.surface_area();
+    if (node.is_leaf()) {
+      count[i] = node.count;
+      cost[i] = costs.intersection * float(node.count) * area;
+      as_leaf[i] = 1;
+      continue;
+    }
+    uint32_t primitives = 0;
+    float split = costs.traversal * area;
+    for (uint32_t c = node.first; c < node.first + node.count; ++c) primitives += count[c], split += cost[c];
+    const float leaf = costs.intersection * float(primitives) * area;
+    count[i] = primitives;
+    as_leaf[i] = primitives <= max_leaf_size && leaf <= split;
+    cost[i] = as_leaf[i] ? leaf : split;
+  }
+  // Top down, depth first, each interior node's children side by side.
+  Bvh out;
+  out.nodes.reserve(n);
+  out.prim_indices.reserve(bvh.prim_indices.size());
+  struct Item {
+    uint32_t from, to;  // a node of `bvh`, and its place in `out`
+  };
+  std::vector<Item> stack{{0, 0}};
+  out.nodes.emplace_back();
+  while (!stack.empty()) {
+    const Item item = stack.back();
+    stack.pop_back();
+    const BvhNode& node = bvh.nodes[item.from];
+    if (as_leaf[item.from]) {
+      const uint32_t first = uint32_t(out.prim_indices.size());
+      gather(bvh, item.from, out.prim_indices);
+      out.nodes[item.to] = BvhNode::make_leaf(node.box, first, count[item.from]);
+      continue;
+    }
+    const uint32_t first = uint32_t(out.nodes.size());
+    out.nodes.resize(out.nodes.size() + node.count);
+    out.nodes[item.to] = BvhNode::make_interior(node.box, first, node.count);
+    for (uint32_t c = node.count; c-- > 0;) stack.push_back({node.first + c, first + c});
+  }
+  return out;
+}
+
+}  // namespace kmbvh

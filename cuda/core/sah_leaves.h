@@ -1,0 +1,28 @@
+// Leaves chosen by SAH over any builder's tree: bottom-up, a subtree of at most
+// max_leaf_size primitives becomes one leaf where that is no dearer than keeping it,
+//   cost(n) = min(k_I * |n| * SA(n), k_T * SA(n) + sum over children cost(c)),
+// the rule the binary builders finish with (cuda/binary/collapse.h; Karras and Aila 2013
+// §3), here over a Bvh of any arity whose leaves may hold several primitives. The k-means
+// builder's SAH-leaves configurations (KMeansParams::sah_leaves) cluster down to a few
+// primitives and let this choose the leaves, instead of the paper's "every cluster of at
+// most m primitives is a leaf" (docs/design.md §4).
+#pragma once
+
+#include <cstdint>
+
+#include "bvh.h"
+
+namespace kmbvh {
+
+struct SahLeafCosts {  // the SAH metric's constants (cuda/metrics/sah.h)
+  float traversal = 3.0f;     // k_T
+  float intersection = 2.0f;  // k_I, per primitive
+};
+
+// `bvh` with each subtree that is cheaper as a leaf, and holds at most max_leaf_size
+// primitives, made one leaf; the leaves of `bvh` are kept whole whatever their size. The
+// nodes come out depth first, each leaf's primitives in the order of the leaves it gathers.
+// Its SAH cost (with these constants) is never above the cost of `bvh`.
+Bvh collapse_leaves_by_sah(const Bvh& bvh, uint32_t max_leaf_size, const SahLeafCosts& costs = {});
+
+}  // namespace kmbvh

@@ -1,0 +1,111 @@
+// Leaves chosen by SAH (cuda/core/sah_leaves.h) and the k-means configurations that use
+// them (Q1S..Q5S, QAS): valid trees, never dearer than the tree they start from, leaves
+// merged exactly where the SAH says so.
+#include <gtest/gtest.h>
+
+#include "adapters/builder_registry.h"
+#include "cuda/core/sah_leaves.h"
+#include "cuda/kmeans/kmeans_builder.h"
+#include "cuda/metrics/sah.h"
+#include "cuda/metrics/validate.h"
+#include "support/scenes.h"
+
+namespace kmbvh {
+namespace {
+
+ValidationLimits leaves_up_to(uint32_t m, uint32_t arity = 2) {
+  ValidationLimits limits;
+  limits.max_leaf_size = m;
+  limits.max_arity = arity;
+  return limits;
+}
+
+TEST(SahLeaves, ValidAndNeverDearerThanTheTreeTheyStartFrom) {
+  for (const bool clustered : {false, true}) {
+    const TriangleScene scene = clustered ? test::clustered_triangles(20000, 5) : test::random_triangles(20000, 6);
+    const PrimitiveSet prims = make_primitive_set(scene);
+    KMeansParams fine = *kmeans_preset("Q3");
+    fine.max_leaf_size = 1;
+    for (const bool wide : {false, true}) {
+      fine.wide = wide;
+      const Bvh bvh = build_kmeans(prims, fine);
+      for (const uint32_t m : {1u, 4u, 8u}) {
+        const Bvh leaves = collapse_leaves_by_sah(bvh, m);
+        const std::string what = std::string(clustered ? "clustered" : "random") + (wide ? ", wide" : "") +
+                                 ", m=" + std::to_string(m);
+        const ValidationReport report = validate(leaves, prims, leaves_up_to(m, wide ? fine.k : 2));
+        EXPECT_TRUE(report.ok()) << what << ": " << report.summary();
+        EXPECT_LE(sah_cost(leaves), sah_cost(bvh) * (1 + 1e-6)) << what;
+        if (m == 1) EXPECT_EQ(leaves.nodes.size(), bvh.nodes.size()) << what << ": nothing to merge";
+        if (m > 1) EXPECT_LT(leaves.nodes.size(), bvh.nodes.size()) << what << ": nothing merged";
+      }
+    }
+  }
+}
+
+// Two primitives under one root, as two leaves: merged when their boxes overlap (one leaf
+// of two costs 2 * 2 * A against 3 * A + 2 * A + 2 * A), kept apart when they are far
+// from each other (the root's area dwarfs theirs).
+TEST(SahLeaves, MergesExactlyWhereTheSahIsLower) {
+  for (const float gap : {0.0f, 100.0f}) {
+    Bvh bvh;
+    const Aabb a(Vec3(0, 0, 0), Vec3(1, 1, 1)), b(Vec3(gap, 0, 0), Vec3(gap + 1, 1, 1));
+    bvh.nodes = {BvhNode::make_interior(join(a, b), 1, 2), BvhNode::make_leaf(a, 0, 1), BvhNode::make_leaf(b, 1, 1)};
+    bvh.prim_indices = {0, 1};
+    const Bvh leaves = collapse_leaves_by_sah(bvh, 8);
+    if (gap == 0.0f) {
+      ASSERT_EQ(leaves.nodes.size(), 1u);
+      EXPECT_TRUE(leaves.root().is_leaf());
+      EXPECT_EQ(leaves.root().count, 2u);
+    } else {
+      ASSERT_EQ(leaves.nodes.size(), 3u);
+      EXPECT_FALSE(leaves.root().is_leaf());
+    }
+    // Never above the limit, however cheap.
+    EXPECT_EQ(collapse_leaves_by_sah(bvh, 1).nodes.size(), 3u);
+  }
+}
+
+TEST(SahLeaves, LeavesAboveTheLimitStayWholeAndEmptyTreesStayEmpty) {
+  const Bvh one = Bvh::single_leaf(Aabb(Vec3(0, 0, 0), Vec3(1, 1, 1)), 20);
+  const Bvh same = collapse_leaves_by_sah(one, 8);
+  ASSERT_EQ(same.nodes.size(), 1u);
+  EXPECT_EQ(same.root().count, 20u);
+  EXPECT_EQ(same.prim_indices, one.prim_indices);
+  EXPECT_TRUE(collapse_leaves_by_sah(Bvh(), 8).empty());
+}
+
+TEST(SahLeaves, PresetsNamedWithAnS) {
+  for (const char* name : {"Q1", "Q3", "Q5", "QA"}) {
+    const KMeansParams paper = *kmeans_preset(name);
+    const std::optional<KMeansParams> s = kmeans_preset(std::string(name) + "s");
+    ASSERT_TRUE(s.has_value()) << name;
+    EXPECT_TRUE(s->sah_leaves);
+    EXPECT_FALSE(paper.sah_leaves);
+    EXPECT_EQ(s->k, paper.k);
+    EXPECT_EQ(s->p, paper.p);
+    EXPECT_EQ(s->i, paper.i);
+    EXPECT_EQ(s->adaptive, paper.adaptive);
+  }
+  EXPECT_EQ(parse_builder("Q3S").label(), "kmeans Q3S");
+  for (const char* wrong : {"QS", "Q6S", "Q3SS", "S"}) EXPECT_FALSE(kmeans_preset(wrong).has_value()) << wrong;
+  EXPECT_THROW(parse_builder("Q6S"), std::invalid_argument);
+}
+
+// The configuration's own tree: clusters of at most three, then the SAH's leaves up to m,
+// and on a scene of rooms (clustered) cheaper than the paper's preset.
+TEST(SahLeaves, KmeansWithSahLeavesIsValidAndCheaper) {
+  const PrimitiveSet prims = make_primitive_set(test::clustered_triangles(30000, 7));
+  BuildInfo info;
+  const Bvh paper = build_kmeans(prims, *kmeans_preset("Q3"));
+  const Bvh sah = build_kmeans(prims, *kmeans_preset("Q3S"), Backend::Cpu, &info);
+  const ValidationReport report = validate(sah, prims, leaves_up_to(8));
+  EXPECT_TRUE(report.ok()) << report.summary();
+  EXPECT_LT(sah_cost(sah), sah_cost(paper));
+  bool timed = false;
+  for (const auto& [phase, ms] : info.phase_ms) timed |= phase == "sah leaves";
+  EXPECT_TRUE(timed);
+}
+
+}  // namespace
+}  // namespace kmbvh
