@@ -6,6 +6,7 @@
 
 #include "adapters/rays/hit_compare.h"
 #include "cuda/traversal/watertight.h"
+#include "support/rays.h"
 
 namespace kmbvh {
 namespace {
@@ -15,14 +16,6 @@ struct Case {
   Ray ray;
 };
 
-Ray ray_of(Vec3 org, Vec3 dir, float tnear) {
-  Ray r;
-  r.org = org;
-  r.dir = dir;
-  r.tnear = tnear;
-  return r;
-}
-
 std::vector<Case> passed_edges() {
   std::vector<Case> cases(2);
   // Conference: the ray passes triangle 0 by 1.4e-5 of its barycentrics, hits 1 at 7e-6
@@ -31,14 +24,14 @@ std::vector<Case> passed_edges() {
                               Vec3(695.805f, 5.10359f, -202.04f));
   cases[0].scene.add_triangle(Vec3(635.49f, 11.7793f, -141.725f), Vec3(636.482f, 11.5556f, -140.717f),
                               Vec3(695.805f, 5.10359f, -202.04f));
-  cases[0].ray = ray_of(Vec3(1087.07068f, 650.288879f, -749.739136f), Vec3(-0.43691051f, -0.669311702f, 0.600941837f),
+  cases[0].ray = test::make_ray(Vec3(1087.07068f, 650.288879f, -749.739136f), Vec3(-0.43691051f, -0.669311702f, 0.600941837f),
                         0.0041468353f);
   // Sponza: passes 0 by 1.3e-5, hits 1 at 2.3e-5 inside, both at t = 6.4102778.
   cases[1].scene.add_triangle(Vec3(0.00724f, 5.848311f, -2.418511f), Vec3(-10.812759f, 5.848311f, -2.41851f),
                               Vec3(-10.82076f, 5.838311f, -2.42651f));
   cases[1].scene.add_triangle(Vec3(-10.812759f, 5.848311f, -2.41851f), Vec3(0.00724f, 5.848311f, -2.418511f),
                               Vec3(0.00724f, 5.863311f, -2.418511f));
-  cases[1].ray = ray_of(Vec3(-9.92169762f, 0.0933787078f, 0.35786438f), Vec3(-0.0801779181f, 0.897766471f, -0.433112949f),
+  cases[1].ray = test::make_ray(Vec3(-9.92169762f, 0.0933787078f, 0.35786438f), Vec3(-0.0801779181f, 0.897766471f, -0.433112949f),
                         6.64466206e-05f);
   return cases;
 }
@@ -77,7 +70,7 @@ TEST(HitCompare, EitherTriangleOfASharedDiagonalIsAnEdgeTie) {
   Case c;
   c.scene.add_triangle(Vec3(0, 0, 0), Vec3(1, 0, 0), Vec3(1, 1, 0));
   c.scene.add_triangle(Vec3(0, 0, 0), Vec3(1, 1, 0), Vec3(0, 1, 0));
-  c.ray = ray_of(Vec3(0.5f, 0.5f, -1), Vec3(0, 0, 1), 0.0f);
+  c.ray = test::make_ray(Vec3(0.5f, 0.5f, -1), Vec3(0, 0, 1), 0.0f);
   EXPECT_EQ(verdict(c, hit_on(c, 0), hit_on(c, 1)).outcome, HitVerdict::EdgeTie);
   EXPECT_EQ(verdict(c, hit_on(c, 1), hit_on(c, 0)).outcome, HitVerdict::EdgeTie);
   EXPECT_EQ(verdict(c, hit_on(c, 0), hit_on(c, 0)).outcome, HitVerdict::Agree);

@@ -144,14 +144,7 @@ TriangleScene unit_square() {
   return s;
 }
 
-Ray make_ray(Vec3 org, Vec3 dir, float tnear = 0.0f, float tfar = kInf) {
-  Ray r;
-  r.org = org;
-  r.dir = dir;
-  r.tnear = tnear;
-  r.tfar = tfar;
-  return r;
-}
+using test::make_ray;
 
 // The wide traversal's counters on a tree small enough to count by hand: a root with three
 // leaves, {0}, {1, 2} and {3}, triangles side by side in z = 0, and rays straight down.

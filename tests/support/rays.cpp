@@ -145,4 +145,13 @@ Bvh chain_tree(const PrimitiveSet& prims) {
   return bvh;
 }
 
+kmbvh::Ray make_ray(Vec3 org, Vec3 dir, float tnear, float tfar) {
+  kmbvh::Ray r;
+  r.org = org;
+  r.dir = dir;
+  r.tnear = tnear;
+  r.tfar = tfar;
+  return r;
+}
+
 }  // namespace kmbvh::test

@@ -38,6 +38,9 @@ Ray random_ray(const Aabb& bounds, uint32_t seed, uint32_t index);
 // something, even in a sparse scene).
 Ray ray_towards_triangle(const TriangleScene& scene, uint32_t seed, uint32_t index);
 
+// One ray in the traversals' conventions (kmbvh::Ray), for the hand-made cases.
+kmbvh::Ray make_ray(Vec3 org, Vec3 dir, float tnear = 0.0f, float tfar = std::numeric_limits<float>::infinity());
+
 // n rays for the traversals, in their conventions: odd ones by random_ray (seed), even ones
 // by ray_towards_triangle (seed + 1); every seventh bounded (tfar 0.5), the rest unbounded.
 std::vector<kmbvh::Ray> traversal_rays(const TriangleScene& scene, uint32_t n, uint32_t seed);
