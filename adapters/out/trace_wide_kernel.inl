@@ -439,12 +439,15 @@ inline bool finish(const Tally& t, TraversalCounters* counted, bool found) {
 // Embree offers hits to an application's filter functions; a refused one is skipped and
 // the traversal goes on.
 //
-// Deferred confirmation (Confirm) gives the answer Exact gives. A deferred run accepts every
-// candidate Exact accepts and perhaps more, so its tmax is never above Exact's and it visits
-// no node Exact skips. If its last candidate c passes the check over the interval it was
-// accepted in, Exact also accepts c when it meets it, and would then accept only a nearer
-// candidate, which the deferred run would have met and accepted after c; so both end on c.
-// If c fails, the ray is traced again with Exact.
+// Deferred confirmation (Confirm) gives the answer Exact gives. Both order candidates alike
+// (confirm_hits: by float t, by exact t when near, then by tie_key), which is one order,
+// the exact one, while float t stay within half of cull_reach of exact t (what
+// distance_trusted checks of the answer). Each run then ends on the first of the candidates
+// it accepts, in that order: every nearer one is within its reach when met. A deferred run
+// accepts every candidate Exact accepts and perhaps more. If its last candidate c passes
+// the check over the interval it was accepted in, Exact accepts c too, and accepts nothing
+// before it that the deferred run would not have taken instead of c; so both end on c. If
+// c fails, the ray is traced again with Exact.
 template <int W, Query query, bool Filtered = false, typename Count = NoTally,
           Confirm confirm = Filtered ? Confirm::Exact : query == Query::Any ? Confirm::Interval : Confirm::Deferred>
 bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit, const HitFilter* filter = nullptr,
