@@ -71,7 +71,7 @@ PluginConfig read_plugin_config() {
   }
   if (!env("KMBVH_PRESET").empty()) {
     if (!kmeans_preset(env("KMBVH_PRESET")))
-      throw std::invalid_argument("KMBVH_PRESET=" + env("KMBVH_PRESET") + ": expected Q1, Q2, Q3, Q4, Q5 or QA");
+      throw std::invalid_argument("KMBVH_PRESET=" + env("KMBVH_PRESET") + ": expected Q1, Q2, Q3, Q4, Q5 or QA, or one of them followed by S (SAH leaves)");
     c.preset = env("KMBVH_PRESET");
   }
   c.k = env_count("KMBVH_K", 2, KMeansParams::kMaxK);

@@ -1,7 +1,7 @@
 // What the plug-in builds with, from the environment (read once per process):
 //   KMBVH_BUILDER  kmeans (default), any kmbvh builder (sweep-sah, lbvh, hlbvh, atrbvh,
 //                  ploc, Q1..Q5), or embree: every call passed to the real Embree
-//   KMBVH_PRESET   k-means preset Q1..Q5; default: chosen by the build quality
+//   KMBVH_PRESET   k-means preset Q1..Q5, QA, or one followed by S; default: chosen by the build quality
 //   KMBVH_K, KMBVH_P, KMBVH_I   k-means parameters, overriding the preset's
 //   KMBVH_LOG=1    one line per build (and per scene) on stderr
 //   KMBVH_BACKEND  cpu (default) or cuda
