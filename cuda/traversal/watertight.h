@@ -155,17 +155,12 @@ KMBVH_HD KMBVH_INLINE bool exact_hit(const Ray& ray, Vec3 a, const ExactEdges& e
   return true;
 }
 
-// exact_hit's t alone: the distance along the ray to the triangle's plane, in double
-// precision from the triangle's own edges; NaN when the ray is parallel to it. Orders two
-// candidates whose float t are too close to be trusted (the wide traversal's confirm_hits).
+// exact_hit's t alone, the same measure exact_check reports; NaN when the ray is parallel
+// to the plane. Orders two candidates whose float t are too close to be trusted (the wide
+// traversal's confirm_hits).
 KMBVH_HD KMBVH_INLINE double exact_distance(const Ray& ray, Vec3 a, Vec3 b, Vec3 c) {
-  const ExactEdges e(a, b, c);
-  const double dx = ray.dir.x, dy = ray.dir.y, dz = ray.dir.z;
-  const double px = dy * e.e2z - dz * e.e2y, py = dz * e.e2x - dx * e.e2z, pz = dx * e.e2y - dy * e.e2x;
-  const double det = e.e1x * px + e.e1y * py + e.e1z * pz;
-  const double sx = double(ray.org.x) - a.x, sy = double(ray.org.y) - a.y, sz = double(ray.org.z) - a.z;
-  const double qx = sy * e.e1z - sz * e.e1y, qy = sz * e.e1x - sx * e.e1z, qz = sx * e.e1y - sy * e.e1x;
-  return det == 0.0 ? double(NAN) : (e.e2x * qx + e.e2y * qy + e.e2z * qz) / det;
+  double t, u, v;
+  return exact_hit(ray, a, ExactEdges(a, b, c), t, u, v) ? t : double(NAN);
 }
 
 // What the double-precision measure of one candidate hit says: whether its t lies in
