@@ -142,7 +142,7 @@ void prepare_builder(const BuilderConfig& config) {
   if (is_embree_builder(config.builder)) shared_embree_device();
 }
 
-Bvh run_builder(const BuilderConfig& config, const PrimitiveSet& prims, BuildInfo* info) {
+Bvh run_builder(const BuilderConfig& config, const PrimitiveSet& prims, BuildInfo* info, BuildContext* context) {
   check_config(config);
   BinaryBuildParams binary = config.binary;
   binary.max_leaf_size = config.max_leaf_size;
@@ -150,7 +150,7 @@ Bvh run_builder(const BuilderConfig& config, const PrimitiveSet& prims, BuildInf
     case BuilderKind::Kmeans: {
       KMeansParams params = config.kmeans;
       params.max_leaf_size = config.max_leaf_size;
-      return build_kmeans(prims, params, config.backend, info);
+      return build_kmeans(prims, params, config.backend, info, context);
     }
     case BuilderKind::Lbvh: return build_lbvh(prims, binary, config.backend, info);
     case BuilderKind::Hlbvh: return build_hlbvh(prims, binary, config.backend, info);

@@ -82,7 +82,8 @@ void* build(BvhObject& object, const RTCBuildArguments& a) {
   builder.max_leaf_size = std::min(std::max(a.maxLeafSize, 1u), kBuilderLeafSize);
   builder.kmeans.wide = false;  // binary, widened to maxBranchingFactor by the SAH (embree_callbacks.h)
   builder.binary.sah = SahCosts{a.traversalCost, a.intersectionCost};
-  const Bvh bvh = run_builder(builder, prims);
+  BuildInfo info;
+  const Bvh bvh = run_builder(builder, prims, &info, &object.build_context());
   const double build_ms = ms_since(start);
   if (!keep_going(a, 0.5)) throw EmbreeError(RTC_ERROR_CANCELLED, "build cancelled");
 
@@ -113,9 +114,9 @@ void* build(BvhObject& object, const RTCBuildArguments& a) {
   if (!keep_going(a, 1.0)) throw EmbreeError(RTC_ERROR_CANCELLED, "build cancelled");
   if (config.log)
     log_line(fmt::format("rtcBuildBVH: {}, {} primitives, {:.2f} ms (build {:.2f} ms, callbacks {:.2f} ms), SAH {:.2f}, "
-                         "{} nodes, {} leaves, depth {}{}",
+                         "{} nodes, {} leaves, depth {}, {} backend allocations{}",
                          builder.label(), prims.size(), ms_since(start), build_ms, ms_since(start) - build_ms,
-                         emitted.sah_cost, emitted.inner_nodes, emitted.leaves, emitted.depth,
+                         emitted.sah_cost, emitted.inner_nodes, emitted.leaves, emitted.depth, info.backend.allocations,
                          emitted.rebalanced ? fmt::format(", {} subtrees rebalanced for maxDepth", emitted.rebalanced)
                                             : std::string()));
   return emitted.root;

@@ -13,6 +13,8 @@
 #include <utility>
 #include <vector>
 
+#include "cuda/core/build_context.h"
+
 namespace kmbvh::plugin {
 
 class BvhObject;
@@ -69,11 +71,16 @@ class BvhObject {
   RTCBVH twin() const { return twin_.get(); }
   void set_twin(std::shared_ptr<RTCBVHTy> twin) { twin_ = std::move(twin); }
 
+  // The builder's working memory, kept for this object's next build (Embree too keeps its
+  // build memory on the BVH); rtcBuildBVH calls on one object do not overlap.
+  BuildContext& build_context() { return build_context_; }
+
  private:
   static constexpr unsigned kTag = 0x6b6d6268;  // "kmbh": tells kmbvh's objects from others
   unsigned tag_ = kTag;
   std::atomic<int> refs_{1};
   std::atomic<bool> emitting_{false};
+  BuildContext build_context_;
   RTCDevice device_;
   size_t block_bytes_ = 64 << 10;
   std::mutex blocks_mutex_;

@@ -18,6 +18,16 @@ std::string ratio_text(double value, double reference) {
 
 }  // namespace
 
+nlohmann::json backend_steps_json(const BuildInfo& info) {
+  const BackendCounters& c = info.backend;
+  nlohmann::json j = {{"launches", c.launches},
+                      {"host_syncs", c.host_syncs},
+                      {"allocations", c.allocations},
+                      {"allocated_bytes", c.allocated_bytes}};
+  if (info.levels > 0) j["host_syncs_per_level"] = double(c.host_syncs) / info.levels;
+  return j;
+}
+
 void normalise_to_sweep(std::vector<Measurement>& rows) {
   const Measurement* sweep = find_label(rows, "sweep-sah");
   if (!sweep || !(sweep->sah_cost > 0)) return;
@@ -69,6 +79,7 @@ nlohmann::json to_json(const Measurement& m) {
       {"phases_ms", phases},
       {"levels", m.info.levels},
       {"forced_splits", m.info.forced_splits},
+      {"backend_steps", backend_steps_json(m.info)},
   };
   if (const auto paper = paper_figures_for(m)) {
     j["paper_sah_cost"] = paper->sah_cost;
@@ -109,6 +120,14 @@ std::string measurement_text(const Measurement& m) {
   line("memory", fmt::format("peak RSS {:.1f} MB; build {:.1f} MB = {:.1f} bytes/triangle", m.peak_rss_mb,
                              m.build_memory_mb, m.build_bytes_per_triangle));
   line("phases (ms)", fmt::format("{}", fmt::join(phases, ", ")));
+  if (m.info.backend.launches > 0) {
+    const BackendCounters& b = m.info.backend;
+    line("backend steps", fmt::format("{} launches, {} host syncs{}, {} allocations ({:.1f} MB), last run",
+                                      b.launches, b.host_syncs,
+                                      m.info.levels ? fmt::format(" ({:.1f} a level)", double(b.host_syncs) / m.info.levels)
+                                                    : "",
+                                      b.allocations, b.allocated_bytes / 1048576.0));
+  }
   line("validation", m.validation.summary());
   return out;
 }

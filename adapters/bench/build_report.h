@@ -17,6 +17,8 @@ namespace kmbvh {
 std::optional<PaperFigures> paper_figures_for(const Measurement& m);
 
 nlohmann::json to_json(const Measurement& m);
+// What the build asked of its backend (BuildInfo::backend), with host syncs per level.
+nlohmann::json backend_steps_json(const BuildInfo& info);
 
 // `kmbvh build`'s report: one "name   value" line per figure.
 std::string measurement_text(const Measurement& m);

@@ -33,6 +33,7 @@ LoadedScene load_scene_argument(const std::string& argument);
 struct MeasureOptions {
   int runs = 5;
   int warmup = 1;
+  bool reuse_memory = true;  // every build in one BuildContext (false: each in fresh memory)
   std::function<void(const std::string&)> progress;  // optional
   Bvh* tree = nullptr;  // when set, receives the last run's tree (to trace rays through it)
 };

@@ -25,7 +25,7 @@ inline Bvh build_atrbvh(const PrimitiveSet& prims, const BinaryBuildParams& para
   Buffer<uint32_t> visits(n - 1);
   for (uint32_t pass = 0; pass < params.treelet_iterations; ++pass) {
     if (info) ++info->levels;
-    thrust::fill(thrust::device, visits.begin(), visits.end(), 0u);
+    thrust::fill(launch(), visits.begin(), visits.end(), 0u);
     for_each_index(n, climb_from_leaves(tree, ptr(visits), RestructureTreelet{tree, state.view(), params.sah,
                                                                              params.max_leaf_size,
                                                                              params.treelet_size}));

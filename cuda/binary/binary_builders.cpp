@@ -26,6 +26,7 @@ Bvh dispatch(BuildFunction cpu, [[maybe_unused]] BuildFunction gpu, const Primit
              const BinaryBuildParams& params, Backend backend, BuildInfo* info) {
   if (const std::string problem = check_params(params); !problem.empty()) throw std::invalid_argument(problem);
   require_backend(backend);
+  const CountBackendSteps counting(info ? &info->backend : nullptr);
 #if defined(KMBVH_HAS_CUDA)
   if (backend == Backend::Cuda) return gpu(prims, params, info);
 #endif

@@ -28,7 +28,7 @@ struct CollapseState {
 // set; with refit, inner boxes are computed on the way up, else they must be set too.
 inline void collapse(const BinaryTreeView& tree, CollapseState& state, uint32_t max_leaf_size, SahCosts k, bool refit) {
   Buffer<uint32_t> visits(tree.n - 1);
-  thrust::fill(thrust::device, visits.begin(), visits.end(), 0u);
+  thrust::fill(launch(), visits.begin(), visits.end(), 0u);
   for_each_index(tree.n, InitLeaves{tree, state.view(), k, nullptr});
   for_each_index(tree.n, climb_from_leaves(tree, ptr(visits), CollapseNode{tree, state.view(), k, max_leaf_size, refit}));
 }
@@ -48,7 +48,7 @@ inline Bvh lay_out(const BinaryTreeView& tree, CollapseView view, const uint32_t
     grow_to(counts, level);
     grow_to(offsets, level);
     for_each_index(level, CountLevel{ptr(frontier), view, ptr(counts)});
-    thrust::exclusive_scan(thrust::device, counts.begin(), counts.begin() + level, offsets.begin(), LevelCounts{},
+    thrust::exclusive_scan(launch(), counts.begin(), counts.begin() + level, offsets.begin(), LevelCounts{},
                            AddLevelCounts{});
     const LevelCounts total = AddLevelCounts{}(offsets[level - 1], counts[level - 1]);
     const uint32_t next_base = level_base + level;

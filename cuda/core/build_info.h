@@ -7,6 +7,8 @@
 #include <utility>
 #include <vector>
 
+#include "backend_counters.h"
+
 namespace kmbvh {
 
 struct BuildInfo {
@@ -19,6 +21,9 @@ struct BuildInfo {
   // Embree: refilling its input array and converting its nodes into a Bvh). Reported build
   // times leave it out, so each builder is charged what an application using it pays.
   double excluded_ms = 0;
+  // What the build asked of its backend: parallel steps, host waits, allocations (the
+  // portable builders; zero for the others).
+  BackendCounters backend;
 
   void add_phase(const std::string& name, double ms) {
     for (auto& [n, t] : phase_ms)

@@ -37,7 +37,7 @@ inline void rebuild_top(BinaryTreeView& tree, Buffer<uint32_t>& parent, Buffer<C
     grow_to(offsets, level);
     for_each_index(level, ChooseTopSplit{ptr(segments), ptr(clusters), ptr(mid)});
     for_each_index(level, CountTopChildren{ptr(segments), ptr(mid), ptr(counts)});
-    thrust::exclusive_scan(thrust::device, counts.begin(), counts.begin() + level, offsets.begin());
+    thrust::exclusive_scan(launch(), counts.begin(), counts.begin() + level, offsets.begin());
     const uint32_t total = offsets[level - 1] + counts[level - 1];
     grow_to(next, total);
     for_each_index(level, LinkTopSegment{ptr(segments), ptr(mid), ptr(offsets), ptr(clusters), ptr(free_nodes),
@@ -60,7 +60,7 @@ inline Bvh build_hlbvh(const PrimitiveSet& prims, const BinaryBuildParams& param
   // The groups of equal 15-bit prefix, their subtrees' roots, and the inner nodes above them.
   Buffer<uint32_t> starts(n), index(n);
   for_each_index(n, MarkClusterStarts{ptr(radix.codes), ptr(starts)});
-  thrust::inclusive_scan(thrust::device, starts.begin(), starts.end(), index.begin());
+  thrust::inclusive_scan(launch(), starts.begin(), starts.end(), index.begin());
   const uint32_t cluster_count = index[n - 1];
   if (cluster_count > 1) {
     Buffer<uint32_t> cluster_first(cluster_count), top(n - 1), free_nodes(cluster_count - 1);
@@ -70,7 +70,7 @@ inline Bvh build_hlbvh(const PrimitiveSet& prims, const BinaryBuildParams& param
     for_each_index(n - 1, FindClusterRoots{ptr(index), ptr(radix.range_first), ptr(radix.range_last), tree,
                                            ptr(clusters), ptr(top)});
     const auto ids = thrust::make_transform_iterator(thrust::counting_iterator<uint32_t>(0), InnerNodeId{n});
-    thrust::copy_if(thrust::device, ids, ids + (n - 1), top.begin(), free_nodes.begin(), IsSet{});
+    thrust::copy_if(launch(), ids, ids + (n - 1), top.begin(), free_nodes.begin(), IsSet{});
     release(starts, index, cluster_first, top, radix.codes, radix.range_first, radix.range_last);
     clock.lap("groups");
     rebuild_top(tree, radix.parent, clusters, free_nodes, cluster_count);

@@ -9,25 +9,27 @@
 namespace kmbvh {
 namespace {
 
-Bvh build_on(Backend backend, const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info) {
+Bvh build_on(Backend backend, const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info,
+             BuildContext* context) {
 #if defined(KMBVH_HAS_CUDA)
-  if (backend == Backend::Cuda) return detail::build_kmeans_gpu(prims, params, info);
+  if (backend == Backend::Cuda) return detail::build_kmeans_gpu(prims, params, info, context);
 #else
   (void)backend;
 #endif
-  return detail::build_kmeans_cpu(prims, params, info);
+  return detail::build_kmeans_cpu(prims, params, info, context);
 }
 
 }  // namespace
 
-Bvh build_kmeans(const PrimitiveSet& prims, const KMeansParams& params, Backend backend, BuildInfo* info) {
+Bvh build_kmeans(const PrimitiveSet& prims, const KMeansParams& params, Backend backend, BuildInfo* info,
+                 BuildContext* context) {
   if (const std::string problem = check_params(params); !problem.empty()) throw std::invalid_argument(problem);
   require_backend(backend);
-  if (!params.sah_leaves) return build_on(backend, prims, params, info);
+  if (!params.sah_leaves) return build_on(backend, prims, params, info, context);
   // SAH leaves: the clusters go down to a few primitives, then the SAH picks the leaves.
   KMeansParams fine = params;
   fine.max_leaf_size = std::min(params.max_leaf_size, KMeansParams::kSahLeafCluster);
-  const Bvh clustered = build_on(backend, prims, fine, info);
+  const Bvh clustered = build_on(backend, prims, fine, info, context);
   const auto start = std::chrono::steady_clock::now();
   Bvh bvh = collapse_leaves_by_sah(clustered, params.max_leaf_size);
   if (info)

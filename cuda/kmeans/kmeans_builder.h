@@ -6,6 +6,7 @@
 #pragma once
 
 #include "../core/backend.h"
+#include "../core/build_context.h"
 #include "../core/build_info.h"
 #include "../core/bvh.h"
 #include "../core/primitive_set.h"
@@ -16,12 +17,14 @@ namespace kmbvh {
 // Throws std::invalid_argument for parameters check_params() rejects, and
 // std::runtime_error when the backend cannot run (no CUDA device).
 // The boxes must be finite with lo <= hi (adapters drop the primitives that are not).
+// With a context, the build's working memory is taken from it and left in it for the next
+// build (build_context.h); the tree is the same either way.
 Bvh build_kmeans(const PrimitiveSet& prims, const KMeansParams& params, Backend backend = Backend::Cpu,
-                 BuildInfo* info = nullptr);
+                 BuildInfo* info = nullptr, BuildContext* context = nullptr);
 
 namespace detail {
-Bvh build_kmeans_cpu(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info);
-Bvh build_kmeans_gpu(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info);
+Bvh build_kmeans_cpu(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info, BuildContext* context);
+Bvh build_kmeans_gpu(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info, BuildContext* context);
 }  // namespace detail
 
 }  // namespace kmbvh

@@ -29,6 +29,7 @@
 
 #include "../core/portable.h"
 #include "../core/breadth_first.h"
+#include "../core/build_context.h"
 #include "../core/parallel_errors.h"
 #include "agglomerate.h"
 #include "assign.h"
@@ -55,15 +56,50 @@ struct IsSplitByIndex {
   KMBVH_HD bool operator()(const Segment& s) const { return s.split_by_index != 0; }
 };
 
+// The level loop's memory, kept in a BuildContext from one build to the next: every buffer
+// keeps its capacity, so a build no larger than the last allocates nothing.
+struct KMeansWorkspace : BuildContext::Workspace {
+  ScratchPool scratch;
+  Buffer<Aabb> boxes[2];
+  Buffer<uint32_t> ids[2];
+  Buffer<uint32_t> final_ids;
+  Buffer<uint8_t> cluster_of;
+  Buffer<Segment> segments, next_segments;
+  Buffer<SegmentSizes> segment_offsets;
+  Buffer<Piece> pieces;
+  Buffer<uint32_t> piece_counters;
+  Buffer<Aabb> reps;
+  Buffer<ClusterSums> sums;
+  Buffer<uint32_t> counts;
+  Buffer<OrderedBounds> bounds;
+  Buffer<uint32_t> cluster_begin;
+  Buffer<uint32_t> cluster_segment;
+  Buffer<ChildCounts> child_counts, child_offsets;
+  Buffer<BvhNode> nodes;
+
+  size_t bytes_held() const override {
+    return scratch.bytes_held() + bytes_reserved(boxes[0]) + bytes_reserved(boxes[1]) + bytes_reserved(ids[0]) +
+           bytes_reserved(ids[1]) + bytes_reserved(final_ids) + bytes_reserved(cluster_of) +
+           bytes_reserved(segments) + bytes_reserved(next_segments) + bytes_reserved(segment_offsets) +
+           bytes_reserved(pieces) + bytes_reserved(piece_counters) + bytes_reserved(reps) + bytes_reserved(sums) +
+           bytes_reserved(counts) + bytes_reserved(bounds) + bytes_reserved(cluster_begin) +
+           bytes_reserved(cluster_segment) + bytes_reserved(child_counts) + bytes_reserved(child_offsets) +
+           bytes_reserved(nodes);
+  }
+};
+
 template <uint32_t KMax, ClusterMetric M>
 class KMeansLevels {
  public:
-  KMeansLevels(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info)
-      : params_(params), n_(static_cast<uint32_t>(prims.size())), info_(info), clock_(info) {
-    boxes_[0] = Buffer<Aabb>(prims.boxes.begin(), prims.boxes.end());
+  // `keep`: the workspace is a context's, and keeps its memory for the next build.
+  KMeansLevels(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info, KMeansWorkspace& ws,
+               bool keep)
+      : params_(params), n_(static_cast<uint32_t>(prims.size())), info_(info), clock_(info), ws_(ws), keep_(keep) {
+    count_host_sync();  // the boxes' upload
+    boxes_[0].assign(prims.boxes.begin(), prims.boxes.end());
     boxes_[1].resize(n_);
     ids_[0].resize(n_);
-    thrust::sequence(thrust::device, ids_[0].begin(), ids_[0].end());
+    thrust::sequence(launch(), ids_[0].begin(), ids_[0].end());
     ids_[1].resize(n_);
     final_ids_.resize(n_);
     cluster_of_.resize(n_);
@@ -73,14 +109,14 @@ class KMeansLevels {
   Bvh run() {
     const Aabb root_box = bounds_of(boxes_[0], n_);
     nodes_.resize(1);
-    nodes_[0] = BvhNode::make_interior(root_box, 0, 0);
+    write(nodes_, 0, BvhNode::make_interior(root_box, 0, 0));
     node_count_ = 1;
     Segment root;
     root.count = n_;
     root.k = rules().child_k(n_);
     root.box = root_box;
     segments_.resize(1);
-    segments_[0] = root;
+    write(segments_, 0, root);
     uint32_t segment_count = 1;
     clock_.lap("setup");
 
@@ -135,7 +171,7 @@ class KMeansLevels {
     for_each_index(piece_count_, AssignPiece<KMax, M, AssignPass::Final>{view()});
     clock_.lap("assign");
     for_each_index(segment_count, DetectSingleCluster{ptr(segments_), this->clusters()});
-    const auto forced = thrust::count_if(thrust::device, segments_.begin(),
+    const auto forced = thrust::count_if(launch(), segments_.begin(),
                                          segments_.begin() + segment_count, IsSplitByIndex{});
     if (forced > 0) {
       for_each_index(piece_count_, AssignPiece<KMax, M, AssignPass::SplitByIndex>{view()});
@@ -149,10 +185,10 @@ class KMeansLevels {
   uint32_t set_up(uint32_t segment_count) {
     const SizesOfSegment sizes{KMBVH_PIECE_SIZE};
     grow_to(segment_offsets_, segment_count);
-    thrust::transform_exclusive_scan(thrust::device, segments_.begin(), segments_.begin() + segment_count,
+    thrust::transform_exclusive_scan(launch(), segments_.begin(), segments_.begin() + segment_count,
                                      segment_offsets_.begin(), sizes, SegmentSizes{}, AddSegmentSizes{});
     const SegmentSizes total =
-        AddSegmentSizes{}(segment_offsets_[segment_count - 1], sizes(segments_[segment_count - 1]));
+        AddSegmentSizes{}(read(segment_offsets_, segment_count - 1), sizes(read(segments_, segment_count - 1)));
     piece_count_ = total.pieces;
     grow_to(pieces_, total.pieces);
     grow_to(piece_counters_, total.counters);
@@ -173,15 +209,15 @@ class KMeansLevels {
   // pieces (AssignPiece), a median update their clusters (UpdateMedians).
   bool all_stable(uint32_t segment_count, uint32_t iteration) {
     for_each_index(segment_count, MarkStable{ptr(segments_), rules(), iteration});
-    return thrust::count_if(thrust::device, segments_.begin(), segments_.begin() + segment_count, IsUnstable{}) == 0;
+    return thrust::count_if(launch(), segments_.begin(), segments_.begin() + segment_count, IsUnstable{}) == 0;
   }
 
   void clear_clusters(uint32_t clusters, bool sums) {
-    thrust::fill_n(thrust::device, counts_.begin(), clusters, 0u);
+    thrust::fill_n(launch(), counts_.begin(), clusters, 0u);
     if (sums)
-      thrust::fill_n(thrust::device, sums_.begin(), clusters, ClusterSums{});
+      thrust::fill_n(launch(), sums_.begin(), clusters, ClusterSums{});
     else
-      thrust::fill_n(thrust::device, bounds_.begin(), clusters, OrderedBounds::empty());
+      thrust::fill_n(launch(), bounds_.begin(), clusters, OrderedBounds::empty());
   }
 
   // Counting sort of every segment by cluster into the other buffer. A median update
@@ -201,12 +237,15 @@ class KMeansLevels {
     grow_to(child_counts_, segment_count);
     grow_to(child_offsets_, segment_count);
     for_each_index(segment_count, CountChildren{ptr(segments_), clusters(), rules(), ptr(child_counts_)});
-    thrust::exclusive_scan(thrust::device, child_counts_.begin(), child_counts_.begin() + segment_count,
+    thrust::exclusive_scan(launch(), child_counts_.begin(), child_counts_.begin() + segment_count,
                            child_offsets_.begin(), ChildCounts{}, AddChildCounts{});
     const ChildCounts total =
-        AddChildCounts{}(child_offsets_[segment_count - 1], child_counts_[segment_count - 1]);
+        AddChildCounts{}(read(child_offsets_, segment_count - 1), read(child_counts_, segment_count - 1));
     nodes_.resize(node_count_ + total.nodes);
     grow_to(next_segments_, total.segments);
+    // The two segment buffers trade places every level, so that a rebuild, whose levels may
+    // put them the other way round, finds room in both.
+    if (segments_.capacity() < next_segments_.capacity()) segments_.reserve(next_segments_.capacity());
     for_each_index(segment_count, EmitChildren<KMax>{ptr(segments_), clusters(), rules(), ptr(child_offsets_),
                                                      node_count_, ptr(nodes_), ptr(next_segments_)});
     node_count_ += total.nodes;
@@ -236,6 +275,7 @@ class KMeansLevels {
     uint32_t* final_ids = ptr(final_ids_);
     uint32_t forced = 0;
     ParallelErrors errors;
+    count_launch();
 #pragma omp parallel reduction(+ : forced)
     {
       SubtreeSplitter<KMax, M> splitter(params_);
@@ -279,20 +319,22 @@ class KMeansLevels {
   std::vector<SubtreeNodes> subtrees_;
 #endif
 
-  // Copies the tree out, freeing each working buffer as soon as it is done with, so that
-  // the finishing step does not raise the build's peak memory.
+  // Copies the tree out. Without a context each working buffer is freed as soon as it is
+  // done with, so that the finishing step does not raise the build's peak memory; a
+  // context's keep theirs for the next build.
   Bvh finish() {
-    release(boxes_[0], boxes_[1], ids_[0], ids_[1], cluster_of_, segments_, next_segments_, segment_offsets_,
-            pieces_, piece_counters_, reps_, sums_, counts_, bounds_, cluster_begin_, cluster_segment_,
-            child_counts_, child_offsets_);
+    if (!keep_)
+      release(boxes_[0], boxes_[1], ids_[0], ids_[1], cluster_of_, segments_, next_segments_, segment_offsets_,
+              pieces_, piece_counters_, reps_, sums_, counts_, bounds_, cluster_begin_, cluster_segment_,
+              child_counts_, child_offsets_);
     Bvh raw;
     raw.nodes = to_host(nodes_, node_count_);
-    release(nodes_);
+    if (!keep_) release(nodes_);
 #if KMBVH_CPU_SUBTREES
     append_subtrees(raw.nodes);
 #endif
     raw.prim_indices = to_host(final_ids_, n_);
-    release(final_ids_);
+    if (!keep_) release(final_ids_);
     Bvh bvh = reorder_breadth_first(std::move(raw));
     clock_.lap("finish");
     return bvh;
@@ -303,45 +345,58 @@ class KMeansLevels {
   const uint32_t n_;
   BuildInfo* info_;
   PhaseClock clock_;
+  KMeansWorkspace& ws_;
+  const bool keep_;
 
   int current_ = 0;  // which of the double buffers holds the level's primitives
-  Buffer<Aabb> boxes_[2];
-  Buffer<uint32_t> ids_[2];
-  Buffer<uint32_t> final_ids_;
-  Buffer<uint8_t> cluster_of_;
+  Buffer<Aabb>* const boxes_ = ws_.boxes;
+  Buffer<uint32_t>* const ids_ = ws_.ids;
+  Buffer<uint32_t>& final_ids_ = ws_.final_ids;
+  Buffer<uint8_t>& cluster_of_ = ws_.cluster_of;
 
-  Buffer<Segment> segments_, next_segments_;
-  Buffer<SegmentSizes> segment_offsets_;
-  Buffer<Piece> pieces_;
+  Buffer<Segment>& segments_ = ws_.segments;
+  Buffer<Segment>& next_segments_ = ws_.next_segments;
+  Buffer<SegmentSizes>& segment_offsets_ = ws_.segment_offsets;
+  Buffer<Piece>& pieces_ = ws_.pieces;
   uint32_t piece_count_ = 0;
-  Buffer<uint32_t> piece_counters_;
+  Buffer<uint32_t>& piece_counters_ = ws_.piece_counters;
 
-  Buffer<Aabb> reps_;
-  Buffer<ClusterSums> sums_;
-  Buffer<uint32_t> counts_;
-  Buffer<OrderedBounds> bounds_;
-  Buffer<uint32_t> cluster_begin_;
-  Buffer<uint32_t> cluster_segment_;
+  Buffer<Aabb>& reps_ = ws_.reps;
+  Buffer<ClusterSums>& sums_ = ws_.sums;
+  Buffer<uint32_t>& counts_ = ws_.counts;
+  Buffer<OrderedBounds>& bounds_ = ws_.bounds;
+  Buffer<uint32_t>& cluster_begin_ = ws_.cluster_begin;
+  Buffer<uint32_t>& cluster_segment_ = ws_.cluster_segment;
 
-  Buffer<ChildCounts> child_counts_, child_offsets_;
-  Buffer<BvhNode> nodes_;
+  Buffer<ChildCounts>& child_counts_ = ws_.child_counts;
+  Buffer<ChildCounts>& child_offsets_ = ws_.child_offsets;
+  Buffer<BvhNode>& nodes_ = ws_.nodes;
   uint32_t node_count_ = 0;
 };
 
 template <ClusterMetric M>
-Bvh build_with_metric(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info) {
+Bvh build_with_metric(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info, KMeansWorkspace& ws,
+                      bool keep) {
   // Local arrays in the kernels are sized by the smallest bound that holds k.
-  if (params.k <= 8) return KMeansLevels<8, M>(prims, params, info).run();
-  if (params.k <= 16) return KMeansLevels<16, M>(prims, params, info).run();
-  if (params.k <= 32) return KMeansLevels<32, M>(prims, params, info).run();
-  return KMeansLevels<64, M>(prims, params, info).run();
+  if (params.k <= 8) return KMeansLevels<8, M>(prims, params, info, ws, keep).run();
+  if (params.k <= 16) return KMeansLevels<16, M>(prims, params, info, ws, keep).run();
+  if (params.k <= 32) return KMeansLevels<32, M>(prims, params, info, ws, keep).run();
+  return KMeansLevels<64, M>(prims, params, info, ws, keep).run();
 }
 
-inline Bvh build(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info) {
+// The build, in `context`'s workspace for this backend when there is one (`key`, one per
+// backend), else in one of its own.
+inline Bvh build(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info, BuildContext* context,
+                 const char* key) {
   const uint32_t n = static_cast<uint32_t>(prims.size());
   if (n <= params.max_leaf_size) return Bvh::single_leaf(prims.bounds(), n);
-  if (params.metric == ClusterMetric::Means) return build_with_metric<ClusterMetric::Means>(prims, params, info);
-  return build_with_metric<ClusterMetric::Medians>(prims, params, info);
+  const CountBackendSteps counting(info ? &info->backend : nullptr);
+  KMeansWorkspace own;
+  KMeansWorkspace& ws = context ? context->workspace<KMeansWorkspace>(key) : own;
+  const UseScratch scratch(ws.scratch);
+  if (params.metric == ClusterMetric::Means)
+    return build_with_metric<ClusterMetric::Means>(prims, params, info, ws, context != nullptr);
+  return build_with_metric<ClusterMetric::Medians>(prims, params, info, ws, context != nullptr);
 }
 
 }  // namespace KMBVH_BACKEND_NAMESPACE

@@ -9,8 +9,8 @@
 
 namespace kmbvh::detail {
 
-Bvh build_kmeans_cpu(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info) {
-  return cpu_backend::build(prims, params, info);
+Bvh build_kmeans_cpu(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info, BuildContext* context) {
+  return cpu_backend::build(prims, params, info, context, "kmeans/cpu");
 }
 
 }  // namespace kmbvh::detail

@@ -6,8 +6,8 @@
 
 namespace kmbvh::detail {
 
-Bvh build_kmeans_gpu(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info) {
-  return gpu_backend::build(prims, params, info);
+Bvh build_kmeans_gpu(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info, BuildContext* context) {
+  return gpu_backend::build(prims, params, info, context, "kmeans/gpu");
 }
 
 }  // namespace kmbvh::detail

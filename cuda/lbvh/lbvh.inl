@@ -50,7 +50,7 @@ inline void build_morton_radix_tree(const PrimitiveSet& prims, MortonRadixTree& 
   t.parent.resize(2 * t.n - 1);
   t.node_box.resize(2 * t.n - 1);
   Buffer<uint32_t> other_end(t.n - 1), root(1);
-  thrust::fill(thrust::device, other_end.begin(), other_end.end(), kNotYet);
+  thrust::fill(launch(), other_end.begin(), other_end.end(), kNotYet);
   BinaryTreeView tree = t.view();
   for_each_index(t.n, InitLeaves{tree, state.view(), params.sah, boxes.data()});
   auto build = build_radix_tree(ptr(t.codes), tree, ptr(other_end), ptr(root),

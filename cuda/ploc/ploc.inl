@@ -67,7 +67,7 @@ inline Bvh build_ploc(const PrimitiveSet& prims, const BinaryBuildParams& params
   BoxColumns cluster_box{ptr(box_columns[0]), n}, next_box{ptr(box_columns[1]), n};
   for_each_index(n, CopyToColumns{tree.box, cluster_box});
   Buffer<MergeCounts> counts(n), offsets(n);
-  thrust::sequence(thrust::device, clusters.begin(), clusters.end());  // leaf i: position i
+  thrust::sequence(launch(), clusters.begin(), clusters.end());  // leaf i: position i
   uint32_t count = n, next_inner = n;
   bool stalled = false;
   while (count > 1) {
@@ -79,7 +79,7 @@ inline Bvh build_ploc(const PrimitiveSet& prims, const BinaryBuildParams& params
       find_nearest(count, params.ploc_radius, cluster_box, nearest);
     }
     for_each_index(count, CountMerges{ptr(nearest), ptr(counts)});
-    thrust::exclusive_scan(thrust::device, counts.begin(), counts.begin() + count, offsets.begin(), MergeCounts{},
+    thrust::exclusive_scan(launch(), counts.begin(), counts.begin() + count, offsets.begin(), MergeCounts{},
                            AddMergeCounts{});
     const MergeCounts total = AddMergeCounts{}(offsets[count - 1], counts[count - 1]);
     for_each_index(count, MergeAndCompact{ptr(clusters), cluster_box, ptr(nearest), ptr(offsets), next_inner, tree,

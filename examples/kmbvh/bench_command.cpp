@@ -108,6 +108,7 @@ int run_bench(const BenchCommand& c) {
       MeasureOptions options;
       options.runs = c.run.runs;
       options.warmup = c.run.warmup;
+      options.reuse_memory = !c.run.fresh_memory;
       options.progress = [&](const std::string& message) {
         progress.update(fmt::format("[{}/{}] {}", step, total, message));
       };

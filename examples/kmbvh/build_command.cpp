@@ -26,6 +26,7 @@ int run_build(const BuildCommand& c) {
   MeasureOptions options;
   options.runs = c.run.runs;
   options.warmup = c.run.warmup;
+  options.reuse_memory = !c.run.fresh_memory;
   options.progress = [&](const std::string& message) { progress.update(message); };
   const Measurement m = measure(scene, config, options);
   progress.done();

@@ -24,6 +24,7 @@ struct RunOptions {
   int warmup = 1;
   bool quiet = false;
   bool json = false;
+  bool fresh_memory = false;
   Backend backend = Backend::Cpu;
 };
 

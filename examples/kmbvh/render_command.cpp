@@ -57,6 +57,7 @@ int run_render(const RenderCommand& c) {
   MeasureOptions options;
   options.runs = c.run.runs;
   options.warmup = c.run.warmup;
+  options.reuse_memory = !c.run.fresh_memory;
   options.progress = [&](const std::string& message) { progress.update(message); };
   const PreparedSystem prepared(scene, look, system, options);
   const std::string layout = system.embree ? "embree" : to_string(system.layout);

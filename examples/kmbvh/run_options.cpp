@@ -41,6 +41,8 @@ void add_run_options(CLI::App& cmd, RunOptions& run) {
   cmd.add_option("--warmup", run.warmup, "untimed runs first")->check(CLI::NonNegativeNumber);
   add_choice(cmd, "--backend", run.backend, names_of({Backend::Cpu, Backend::Cuda}),
              "where the portable builders run: cpu or cuda");
+  cmd.add_flag("--fresh-memory", run.fresh_memory,
+               "every build in fresh memory, as without a build context (by default the runs reuse the first's)");
   cmd.add_flag("--json", run.json, "print JSON instead of tables");
   cmd.add_flag("-q,--quiet", run.quiet, "no progress on stderr");
 }

@@ -75,7 +75,7 @@ bool SceneAccel::trace_filtered(const Ray& ray, const RTCRay& app_ray, unsigned 
 }
 
 SceneAccel::SceneAccel(const std::vector<EmbreeTriangleMesh>& meshes, std::vector<GeometryFilters> filters,
-                       RTCBuildQuality quality, AccelReport& report)
+                       RTCBuildQuality quality, AccelReport& report, BuildContext* context)
     : filters_(std::move(filters)) {
   for (const GeometryFilters& f : filters_) {
     intersect_filters_ |= f.intersect != nullptr;
@@ -92,7 +92,9 @@ SceneAccel::SceneAccel(const std::vector<EmbreeTriangleMesh>& meshes, std::vecto
   report.isa = to_string(traversal_isa());  // a KMBVH_ISA this CPU cannot run fails here, before the build
   if (!flat.scene.triangles.empty()) {  // else every ray misses
     const PrimitiveSet prims = make_primitive_set(flat.scene);
-    const Bvh bvh = run_builder(config, prims);
+    BuildInfo info;
+    const Bvh bvh = run_builder(config, prims, &info, context);
+    report.allocations = info.backend.allocations;
     report.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     report.sah = sah_cost(bvh);
     tracer_ = std::make_unique<Tracer>(bvh, prims, flat.scene, Layout::Bvh8, Backend::Cpu, &flat.ids);

@@ -12,6 +12,7 @@
 
 #include "adapters/embree/embree_geometry.h"
 #include "adapters/out/tracer.h"
+#include "cuda/core/build_context.h"
 #include "ray_recorder.h"
 
 namespace kmbvh::plugin {
@@ -21,6 +22,7 @@ struct AccelReport {
   size_t triangles = 0, meshes = 0, dropped = 0;
   double build_ms = 0, layout_ms = 0;
   double sah = 0;
+  uint64_t allocations = 0;  // backend memory the build allocated (none when the scene's context held enough)
   std::string isa;  // the traversal kernel's instruction set (adapters/out/cpu_isa.h)
 };
 
@@ -57,9 +59,10 @@ struct AccelGeometry {
 class SceneAccel {
  public:
   // filters: by geomID (empty: none). Throws (std::exception) when the meshes cannot be
-  // read or the build fails: the caller lets Embree answer for the scene.
+  // read or the build fails: the caller lets Embree answer for the scene. `context`: the
+  // scene's build memory, kept from one commit to the next (may be null).
   SceneAccel(const std::vector<EmbreeTriangleMesh>& meshes, std::vector<GeometryFilters> filters,
-             RTCBuildQuality quality, AccelReport& report);
+             RTCBuildQuality quality, AccelReport& report, BuildContext* context = nullptr);
   ~SceneAccel();
 
   // Whether some geometry has a filter for this query (most scenes: none, and the

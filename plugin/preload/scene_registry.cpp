@@ -51,6 +51,7 @@ struct SceneRecord {
   std::atomic<const SceneAccel*> accel{nullptr};
   std::atomic<bool> embree_current{true};  // false while kmbvh has deferred Embree's commit
   std::mutex commit_mutex;                  // one build at a time (rtcJoinCommitScene)
+  BuildContext build_context;               // kept for the next commit's build, under commit_mutex
   std::string last_fallback;                // logged when it changes
 };
 
@@ -442,16 +443,17 @@ void commit_or_build(RTCScene scene, bool join) {
   std::unique_ptr<SceneAccel> accel;
   AccelReport report;
   try {
-    accel = std::make_unique<SceneAccel>(meshes, std::move(filters), quality, report);
+    accel = std::make_unique<SceneAccel>(meshes, std::move(filters), quality, report, &s->build_context);
   } catch (const std::exception& e) {
     return commit_by_embree(scene, *s, join, std::string("kmbvh could not build it: ") + e.what(), instanced);
   }
   if (plugin_config().log)
-    log_line(fmt::format("scene {}: {}, {} triangles in {} meshes{}{}, build {:.1f} ms + layout {:.1f} ms ({} kernel), SAH {:.2f}{}",
+    log_line(fmt::format("scene {}: {}, {} triangles in {} meshes{}{}, build {:.1f} ms + layout {:.1f} ms ({} kernel), "
+                         "SAH {:.2f}, {} backend allocations{}",
                          static_cast<void*>(scene), report.builder, report.triangles, report.meshes,
                          report.dropped ? fmt::format(" ({} dropped as Embree drops them)", report.dropped) : "",
                          accel->has_filters(Query::Closest) || accel->has_filters(Query::Any) ? " with filter functions" : "",
-                         report.build_ms, report.layout_ms, report.isa, report.sah,
+                         report.build_ms, report.layout_ms, report.isa, report.sah, report.allocations,
                          embree_too ? "; Embree builds it too (instanced)" : "; Embree's build deferred"));
   {
     std::lock_guard<std::mutex> lock(registry().mutex);

@@ -1,0 +1,117 @@
+// Build contexts (cuda/core/build_context.h) and the backend's counters
+// (cuda/core/backend_counters.h): a build in a context builds the tree a build without one
+// does, a second build no larger than the first allocates nothing, and the counters count
+// the level loop's steps as the loop is written.
+#include <gtest/gtest.h>
+
+#include <cstring>
+
+#include "cuda/binary/binary_builders.h"
+#include "cuda/kmeans/kmeans_builder.h"
+#include "support/scenes.h"
+
+namespace kmbvh {
+namespace {
+
+bool same_tree(const Bvh& a, const Bvh& b) {
+  return a.nodes.size() == b.nodes.size() && a.prim_indices == b.prim_indices &&
+         std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(BvhNode)) == 0;
+}
+
+class EveryConfiguration : public ::testing::TestWithParam<const char*> {};
+
+TEST_P(EveryConfiguration, RebuildInAContextAllocatesNothingAndBuildsTheSameTree) {
+  const PrimitiveSet large = make_primitive_set(test::clustered_triangles(30000, 11));
+  const PrimitiveSet small = make_primitive_set(test::random_triangles(12000, 12));
+  for (ClusterMetric metric : {ClusterMetric::Means, ClusterMetric::Medians})
+    for (bool subtrees : {true, false}) {
+      KMeansParams params = *kmeans_preset(GetParam());
+      params.metric = metric;
+      params.cpu_subtrees = subtrees;
+      const std::string what = std::string(GetParam()) + " " + to_string(metric) + (subtrees ? "" : " level loop");
+      BuildContext context;
+      BuildInfo first, second, smaller;
+      const Bvh a = build_kmeans(large, params, Backend::Cpu, &first, &context);
+      EXPECT_GT(first.backend.allocations, 0u) << what;
+      EXPECT_GT(context.bytes_held(), 0u) << what;
+      const Bvh b = build_kmeans(large, params, Backend::Cpu, &second, &context);
+      EXPECT_EQ(second.backend.allocations, 0u) << what;
+      EXPECT_EQ(second.backend.launches, first.backend.launches) << what;
+      EXPECT_TRUE(same_tree(a, build_kmeans(large, params))) << what;
+      EXPECT_TRUE(same_tree(a, b)) << what;
+      // A smaller scene fits in what the larger one left.
+      const Bvh c = build_kmeans(small, params, Backend::Cpu, &smaller, &context);
+      EXPECT_EQ(smaller.backend.allocations, 0u) << what;
+      EXPECT_TRUE(same_tree(c, build_kmeans(small, params))) << what;
+      context.release();
+      EXPECT_EQ(context.bytes_held(), 0u);
+    }
+}
+
+INSTANTIATE_TEST_SUITE_P(KMeans, EveryConfiguration, ::testing::Values("Q1", "Q2", "Q3", "QA", "Q3S"));
+
+// The level loop's steps counted by hand (kmeans_builder.inl), for a preset of i Lloyd
+// iterations with a fixed count (not QA) and without the CPU subtree path:
+// - once: the ids' sequence and the root's bounds (2 launches); the boxes' upload and the
+//   root node and segment written (3 syncs); the tree copied out (2 syncs);
+// - per level: set-up (scan + SetupSegment), initialise, i x (2 fills + assign + update),
+//   the final fills (2), assignment, single-cluster detection and its count, partition
+//   (place + scatter), emit (count + scan + EmitChildren): 13 + 4i launches, each waited
+//   for, and 4 values read back (the set-up's and the emit's totals, two reads each).
+TEST(BackendCounters, CountTheLevelLoopsSteps) {
+  const PrimitiveSet prims = make_primitive_set(test::random_triangles(20000, 13));
+  for (const char* preset : {"Q1", "Q2", "Q3"}) {
+    KMeansParams params = *kmeans_preset(preset);
+    params.cpu_subtrees = false;
+    BuildInfo info;
+    build_kmeans(prims, params, Backend::Cpu, &info);
+    ASSERT_EQ(info.forced_splits, 0u) << preset;  // which would add a pass to its level
+    ASSERT_GT(info.levels, 2u) << preset;
+    const uint64_t launches = 2 + info.levels * (13 + 4 * params.i);
+    EXPECT_EQ(info.backend.launches, launches) << preset;
+    EXPECT_EQ(info.backend.host_syncs, launches + 3 + 4 * info.levels + 2) << preset;
+  }
+}
+
+// The CPU subtree path finishes small nodes in one parallel step per level instead of the
+// level loop's thirteen or more.
+TEST(BackendCounters, SubtreePathTakesFewerSteps) {
+  const PrimitiveSet prims = make_primitive_set(test::clustered_triangles(30000, 14));
+  KMeansParams params = *kmeans_preset("Q2");
+  BuildInfo with, without;
+  build_kmeans(prims, params, Backend::Cpu, &with);
+  params.cpu_subtrees = false;
+  build_kmeans(prims, params, Backend::Cpu, &without);
+  EXPECT_LT(with.backend.launches, without.backend.launches);
+  EXPECT_GT(with.backend.launches, 0u);
+}
+
+// The binary builders count their steps too (they take no context: each build allocates).
+TEST(BackendCounters, BinaryBuildersCountTheirSteps) {
+  const PrimitiveSet prims = make_primitive_set(test::random_triangles(5000, 15));
+  BinaryBuildParams params;
+  for (auto build : {build_lbvh, build_hlbvh, build_atrbvh, build_ploc}) {
+    BuildInfo info;
+    build(prims, params, Backend::Cpu, &info);
+    EXPECT_GT(info.backend.launches, 0u);
+    EXPECT_GE(info.backend.host_syncs, info.backend.launches);
+    EXPECT_GT(info.backend.allocations, 0u);
+  }
+}
+
+// Nothing is counted outside a build that asked for it, and a build without BuildInfo
+// counts nowhere.
+TEST(BackendCounters, CountOnlyWhereAsked) {
+  const PrimitiveSet prims = make_primitive_set(test::random_triangles(3000, 16));
+  BackendCounters outer;
+  {
+    const CountBackendSteps counting(&outer);
+    build_kmeans(prims, *kmeans_preset("Q2"));  // no BuildInfo: its own scope counts nowhere
+  }
+  EXPECT_EQ(outer.launches, 0u);
+  EXPECT_EQ(outer.allocations, 0u);
+  EXPECT_EQ(detail::counted_backend(), nullptr);
+}
+
+}  // namespace
+}  // namespace kmbvh
