@@ -1,5 +1,7 @@
 #include "triangle_scene.h"
 
+#include "cuda/core/huge_pages.h"
+
 namespace kmbvh {
 
 Aabb TriangleScene::triangle_box(size_t t) const {
@@ -38,8 +40,8 @@ void TriangleScene::add_triangle(Vec3 a, Vec3 b, Vec3 c) {
 
 PrimitiveSet make_primitive_set(const TriangleScene& scene, size_t* dropped) {
   PrimitiveSet set;
-  set.boxes.reserve(scene.size());
-  set.ids.reserve(scene.size());
+  reserve_on_huge_pages(set.boxes, scene.size());
+  reserve_on_huge_pages(set.ids, scene.size());
   size_t skipped = 0;
   for (size_t t = 0; t < scene.size(); ++t) {
     const Triangle& v = scene.triangles[t];

@@ -2,15 +2,17 @@
 
 #include <utility>
 
+#include "huge_pages.h"
+
 namespace kmbvh {
 
 Bvh reorder_breadth_first(Bvh in) {
   Bvh out;
   out.prim_indices = std::move(in.prim_indices);
   if (in.nodes.empty()) return out;
-  out.nodes.reserve(in.nodes.size());
+  reserve_on_huge_pages(out.nodes, in.nodes.size());
   std::vector<uint32_t> source;  // source[i]: the input index of output node i
-  source.reserve(in.nodes.size());
+  reserve_on_huge_pages(source, in.nodes.size());
   out.nodes.push_back(in.nodes[0]);
   source.push_back(0);
   for (size_t q = 0; q < out.nodes.size(); ++q) {

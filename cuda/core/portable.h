@@ -26,6 +26,7 @@
 #include "aabb.h"
 #include "backend_counters.h"
 #include "build_info.h"
+#include "huge_pages.h"
 #if KMBVH_BACKEND_CPU
 #include "radix_sort_cpu.h"
 #endif
@@ -48,7 +49,11 @@ struct UninitializedAllocator : thrust::device_allocator<T> {
   UninitializedAllocator(const UninitializedAllocator<U>&) {}
   typename Base::pointer allocate(typename Base::size_type n) {
     count_allocation(n * sizeof(T));
-    return Base::allocate(n);
+    const typename Base::pointer p = Base::allocate(n);
+#if KMBVH_BACKEND_CPU
+    advise_huge_pages(thrust::raw_pointer_cast(p), n * sizeof(T));  // host memory: huge_pages.h
+#endif
+    return p;
   }
   KMBVH_HD void construct(T*) {}
 };
@@ -177,7 +182,10 @@ template <typename T>
 std::vector<T> to_host(const T* p, size_t n) {
   count_host_sync();
 #if KMBVH_BACKEND_CPU
-  return std::vector<T>(p, p + n);  // host memory already: one pass, no zero fill
+  std::vector<T> h;  // host memory already: one pass, no zero fill
+  reserve_on_huge_pages(h, n);
+  h.insert(h.end(), p, p + n);
+  return h;
 #else
   std::vector<T> h(n);
   thrust::copy(thrust::device_pointer_cast(p), thrust::device_pointer_cast(p) + n, h.begin());

@@ -299,6 +299,7 @@ class KMeansLevels {
       offset[t] = static_cast<uint32_t>(total);
       total += subtrees_[t].nodes.size() - 1;
     }
+    reserve_on_huge_pages(nodes, total);
     nodes.resize(total);
 #pragma omp parallel for schedule(dynamic, 16)
     for (int64_t t = 0; t < int64_t(subtrees_.size()); ++t) {
