@@ -4,6 +4,7 @@
 #include <cstdint>
 #include <new>
 
+#include "cuda/core/huge_pages.h"
 #include "real_embree.h"
 
 namespace kmbvh::plugin {
@@ -57,6 +58,7 @@ std::pair<char*, size_t> BvhObject::new_block(size_t at_least) {
   const size_t n = std::max(at_least, block_bytes_);
   std::unique_ptr<char[]> block(new char[n]);  // not zeroed: the callbacks write what they use
   char* p = block.get();
+  advise_huge_pages(p, n);
   std::lock_guard<std::mutex> lock(blocks_mutex_);
   blocks_.push_back(std::move(block));
   return {p, n};

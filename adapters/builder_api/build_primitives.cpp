@@ -5,10 +5,14 @@
 #include <cmath>
 #include <stdexcept>
 
+#include "cuda/core/huge_pages.h"
+
 namespace kmbvh {
 
 PrimitiveSet primitive_set_from(const RTCBuildPrimitive* primitives, size_t count) {
   PrimitiveSet set;
+  reserve_on_huge_pages(set.boxes, count);
+  reserve_on_huge_pages(set.ids, count);
   set.boxes.resize(count);
   set.ids.resize(count);
   for (size_t i = 0; i < count; ++i) {

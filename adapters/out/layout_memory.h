@@ -9,14 +9,14 @@
 //   element whole), so the first touch is the fill's, on every thread.
 #pragma once
 
-#include <sys/mman.h>
-
 #include <cstddef>
 #include <cstdlib>
 #include <new>
 #include <type_traits>
 #include <utility>
 #include <vector>
+
+#include "cuda/core/huge_pages.h"
 
 namespace kmbvh {
 
@@ -36,7 +36,7 @@ struct LayoutAllocator {
     void* p = nullptr;
     if (bytes >= kHugePage) {
       p = std::aligned_alloc(kHugePage, (bytes + kHugePage - 1) / kHugePage * kHugePage);
-      if (p) madvise(p, bytes, MADV_HUGEPAGE);  // advice only: where it is refused, small pages
+      if (p) advise_huge_pages(p, bytes);  // advice only: where it is refused, small pages
     } else {  // aligned_alloc wants a size that is a multiple of the alignment (ASan checks it)
       constexpr size_t align = alignof(T) > alignof(std::max_align_t) ? alignof(T) : alignof(std::max_align_t);
       p = std::aligned_alloc(align, (bytes + align) / align * align);

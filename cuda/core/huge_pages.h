@@ -11,9 +11,9 @@
 
 namespace kmbvh {
 
-// Asks for huge pages over the whole 2 MiB pages inside [p, p + bytes) that are not yet
-// touched; arrays under 4 MiB are left alone (their pages are few, and rounding to huge
-// pages could waste up to half).
+// Asks for huge pages over the whole 2 MiB pages inside [p, p + bytes), which should not
+// be touched yet (an array 2 MiB-aligned by its allocator is covered whole; one from malloc
+// all but its ends).
 void advise_huge_pages(const void* p, size_t bytes);
 
 // v.reserve(n), with the new storage advised before anything is written to it.

@@ -193,6 +193,17 @@ std::vector<T> to_host(const T* p, size_t n) {
 #endif
 }
 
+// n elements from backend memory into host memory at `out`.
+template <typename T>
+void copy_to_host(const T* p, size_t n, T* out) {
+  count_host_sync();
+#if KMBVH_BACKEND_CPU
+  std::copy(p, p + n, out);
+#else
+  thrust::copy(thrust::device_pointer_cast(p), thrust::device_pointer_cast(p) + n, out);
+#endif
+}
+
 template <typename T>
 std::vector<T> to_host(Buffer<T>& b, size_t n) {
   return to_host(static_cast<const T*>(ptr(b)), n);

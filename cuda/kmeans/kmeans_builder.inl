@@ -76,9 +76,13 @@ struct KMeansWorkspace : BuildContext::Workspace {
   Buffer<uint32_t> cluster_segment;
   Buffer<ChildCounts> child_counts, child_offsets;
   Buffer<BvhNode> nodes;
+  // Host memory of the finishing step: the nodes as built, and the breadth-first order's scratch.
+  std::vector<BvhNode> built_nodes;
+  std::vector<uint32_t> order_scratch;
 
   size_t bytes_held() const override {
-    return scratch.bytes_held() + bytes_reserved(boxes[0]) + bytes_reserved(boxes[1]) + bytes_reserved(ids[0]) +
+    return built_nodes.capacity() * sizeof(BvhNode) + order_scratch.capacity() * sizeof(uint32_t) +
+           scratch.bytes_held() + bytes_reserved(boxes[0]) + bytes_reserved(boxes[1]) + bytes_reserved(ids[0]) +
            bytes_reserved(ids[1]) + bytes_reserved(final_ids) + bytes_reserved(cluster_of) +
            bytes_reserved(segments) + bytes_reserved(next_segments) + bytes_reserved(segment_offsets) +
            bytes_reserved(pieces) + bytes_reserved(piece_counters) + bytes_reserved(reps) + bytes_reserved(sums) +
@@ -290,17 +294,20 @@ class KMeansLevels {
     return kept;
   }
 
-  // Appends the subtrees' nodes after the level loop's, renumbered: a subtree's node 0 is
-  // its segment's node, and its node i > 0 lands at offset + i - 1.
-  void append_subtrees(std::vector<BvhNode>& nodes) {
-    std::vector<uint32_t> offset(subtrees_.size());
+  // Where each subtree's nodes go after the level loop's: its node i > 0 at offset + i - 1
+  // (its node 0 is its segment's node). Returns the tree's node count.
+  size_t place_subtrees(std::vector<uint32_t>& offset) const {
+    offset.resize(subtrees_.size());
     size_t total = node_count_;
     for (size_t t = 0; t < subtrees_.size(); ++t) {
       offset[t] = static_cast<uint32_t>(total);
       total += subtrees_[t].nodes.size() - 1;
     }
-    reserve_on_huge_pages(nodes, total);
-    nodes.resize(total);
+    return total;
+  }
+
+  // Writes the subtrees' nodes into `nodes`, after the level loop's, renumbered.
+  void append_subtrees(BvhNode* nodes, const std::vector<uint32_t>& offset) {
 #pragma omp parallel for schedule(dynamic, 16)
     for (int64_t t = 0; t < int64_t(subtrees_.size()); ++t) {
       const SubtreeNodes& sub = subtrees_[t];
@@ -320,23 +327,35 @@ class KMeansLevels {
   std::vector<SubtreeNodes> subtrees_;
 #endif
 
-  // Copies the tree out. Without a context each working buffer is freed as soon as it is
-  // done with, so that the finishing step does not raise the build's peak memory; a
-  // context's keep theirs for the next build.
+  // Copies the tree out: its nodes as built into host memory of the workspace, then in
+  // breadth-first order into the tree returned. Without a context each working buffer is
+  // freed as soon as it is done with, so that the finishing step does not raise the build's
+  // peak memory; a context's keep theirs for the next build, so that only the tree returned
+  // is fresh memory.
   Bvh finish() {
     if (!keep_)
       release(boxes_[0], boxes_[1], ids_[0], ids_[1], cluster_of_, segments_, next_segments_, segment_offsets_,
               pieces_, piece_counters_, reps_, sums_, counts_, bounds_, cluster_begin_, cluster_segment_,
               child_counts_, child_offsets_);
-    Bvh raw;
-    raw.nodes = to_host(nodes_, node_count_);
+    size_t total = node_count_;
+#if KMBVH_CPU_SUBTREES
+    std::vector<uint32_t> offset;
+    total = place_subtrees(offset);
+#endif
+    std::vector<BvhNode>& built = ws_.built_nodes;
+    if (built.size() < total) {  // kept at its largest: no zero fill when it fits
+      reserve_on_huge_pages(built, total);
+      built.resize(total);
+    }
+    copy_to_host(ptr(nodes_), node_count_, built.data());
     if (!keep_) release(nodes_);
 #if KMBVH_CPU_SUBTREES
-    append_subtrees(raw.nodes);
+    append_subtrees(built.data(), offset);
 #endif
-    raw.prim_indices = to_host(final_ids_, n_);
+    Bvh bvh;
+    bvh.prim_indices = to_host(final_ids_, n_);
     if (!keep_) release(final_ids_);
-    Bvh bvh = reorder_breadth_first(std::move(raw));
+    bvh.nodes = breadth_first_nodes(built.data(), total, ws_.order_scratch);
     clock_.lap("finish");
     return bvh;
   }
