@@ -152,10 +152,10 @@ Bvh run_builder(const BuilderConfig& config, const PrimitiveSet& prims, BuildInf
       params.max_leaf_size = config.max_leaf_size;
       return build_kmeans(prims, params, config.backend, info, context);
     }
-    case BuilderKind::Lbvh: return build_lbvh(prims, binary, config.backend, info);
-    case BuilderKind::Hlbvh: return build_hlbvh(prims, binary, config.backend, info);
-    case BuilderKind::Atrbvh: return build_atrbvh(prims, binary, config.backend, info);
-    case BuilderKind::Ploc: return build_ploc(prims, binary, config.backend, info);
+    case BuilderKind::Lbvh: return build_lbvh(prims, binary, config.backend, info, context);
+    case BuilderKind::Hlbvh: return build_hlbvh(prims, binary, config.backend, info, context);
+    case BuilderKind::Atrbvh: return build_atrbvh(prims, binary, config.backend, info, context);
+    case BuilderKind::Ploc: return build_ploc(prims, binary, config.backend, info, context);
     case BuilderKind::SweepSah: {
       SweepSahParams params;
       params.max_leaf_size = config.max_leaf_size;

@@ -62,8 +62,8 @@ void check_config(const BuilderConfig& config);
 void prepare_builder(const BuilderConfig& config);
 
 // Throws std::invalid_argument for a bad configuration, std::runtime_error when the builder fails.
-// `context`: working memory kept from one build to the next (build_context.h; the k-means
-// builder uses it, the others build as they would without it).
+// `context`: working memory kept from one build to the next (build_context.h; the portable
+// builders use it, sweep-sah and Embree's build as they would without it).
 Bvh run_builder(const BuilderConfig& config, const PrimitiveSet& prims, BuildInfo* info = nullptr,
                 BuildContext* context = nullptr);
 

@@ -86,16 +86,26 @@ TEST(BackendCounters, SubtreePathTakesFewerSteps) {
   EXPECT_GT(with.backend.launches, 0u);
 }
 
-// The binary builders count their steps too (they take no context: each build allocates).
-TEST(BackendCounters, BinaryBuildersCountTheirSteps) {
-  const PrimitiveSet prims = make_primitive_set(test::random_triangles(5000, 15));
-  BinaryBuildParams params;
-  for (auto build : {build_lbvh, build_hlbvh, build_atrbvh, build_ploc}) {
-    BuildInfo info;
-    build(prims, params, Backend::Cpu, &info);
-    EXPECT_GT(info.backend.launches, 0u);
-    EXPECT_GE(info.backend.host_syncs, info.backend.launches);
-    EXPECT_GT(info.backend.allocations, 0u);
+// The binary builders count their steps too, and in a context their buffers come from its
+// pool: a rebuild of the same scene allocates nothing and builds the same tree.
+TEST(BinaryBuilders, RebuildInAContextAllocatesNothingAndBuildsTheSameTree) {
+  const PrimitiveSet prims = make_primitive_set(test::clustered_triangles(20000, 15));
+  const BinaryBuildParams params;
+  const std::pair<const char*, decltype(&build_lbvh)> builders[] = {
+      {"lbvh", build_lbvh}, {"hlbvh", build_hlbvh}, {"atrbvh", build_atrbvh}, {"ploc", build_ploc}};
+  for (const auto& [name, build] : builders) {
+    BuildContext context;
+    BuildInfo first, second;
+    const Bvh fresh = build(prims, params, Backend::Cpu, nullptr, nullptr);
+    const Bvh a = build(prims, params, Backend::Cpu, &first, &context);
+    const Bvh b = build(prims, params, Backend::Cpu, &second, &context);
+    EXPECT_GT(first.backend.launches, 0u) << name;
+    EXPECT_GE(first.backend.host_syncs, first.backend.launches) << name;
+    EXPECT_GT(first.backend.allocations, 0u) << name;
+    EXPECT_EQ(second.backend.allocations, 0u) << name;
+    EXPECT_GT(context.bytes_held(), 0u) << name;
+    EXPECT_TRUE(same_tree(fresh, a)) << name;
+    EXPECT_TRUE(same_tree(a, b)) << name;
   }
 }
 

@@ -36,6 +36,22 @@ TEST(KMeansGpu, ValidTreesAsGoodAsTheCpuBackend) {
       }
 }
 
+// A build context on the GPU: the rebuild allocates no device memory and builds the same tree.
+TEST(KMeansGpu, RebuildInAContextAllocatesNothing) {
+  if (!cuda_device_available()) GTEST_SKIP() << "no CUDA device";
+  const PrimitiveSet prims = make_primitive_set(test::clustered_triangles(200000, 56));
+  for (const char* preset : {"Q1", "Q2", "QA"}) {
+    BuildContext context;
+    BuildInfo first, second;
+    const Bvh a = build_kmeans(prims, *kmeans_preset(preset), Backend::Cuda, &first, &context);
+    const Bvh b = build_kmeans(prims, *kmeans_preset(preset), Backend::Cuda, &second, &context);
+    EXPECT_GT(first.backend.allocations, 0u) << preset;
+    EXPECT_EQ(second.backend.allocations, 0u) << preset;
+    EXPECT_EQ(a.prim_indices, b.prim_indices) << preset;
+    EXPECT_EQ(sah_cost(a), sah_cost(b)) << preset;
+  }
+}
+
 TEST(KMeansGpu, DegenerateInputs) {
   if (!cuda_device_available()) GTEST_SKIP() << "no CUDA device";
   for (const TriangleScene& scene : {test::identical_triangles(100000), test::shared_centroid_triangles(20000),
@@ -48,15 +64,15 @@ TEST(KMeansGpu, DegenerateInputs) {
 
 TEST(BinaryBuildersGpu, ValidTreesAsGoodAsTheCpuBackend) {
   if (!cuda_device_available()) GTEST_SKIP() << "no CUDA device: the GPU backend is compiled but not run here";
-  using Build = Bvh (*)(const PrimitiveSet&, const BinaryBuildParams&, Backend, BuildInfo*);
+  using Build = Bvh (*)(const PrimitiveSet&, const BinaryBuildParams&, Backend, BuildInfo*, BuildContext*);
   const std::pair<const char*, Build> builders[] = {
       {"lbvh", build_lbvh}, {"hlbvh", build_hlbvh}, {"atrbvh", build_atrbvh}, {"ploc", build_ploc}};
   for (const TriangleScene& scene : {test::clustered_triangles(200000, 54), test::identical_triangles(100000),
                                      test::shared_centroid_triangles(20000), test::random_triangles(2, 55)}) {
     const PrimitiveSet prims = make_primitive_set(scene);
     for (const auto& [name, build] : builders) {
-      const Bvh gpu = build(prims, BinaryBuildParams{}, Backend::Cuda, nullptr);
-      const Bvh cpu = build(prims, BinaryBuildParams{}, Backend::Cpu, nullptr);
+      const Bvh gpu = build(prims, BinaryBuildParams{}, Backend::Cuda, nullptr, nullptr);
+      const Bvh cpu = build(prims, BinaryBuildParams{}, Backend::Cpu, nullptr, nullptr);
       const ValidationReport report = validate(gpu, prims, {});
       EXPECT_TRUE(report.ok()) << name << " on " << scene.name << ": " << report.summary();
       if (sah_cost(cpu) > 0) {

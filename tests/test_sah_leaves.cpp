@@ -36,8 +36,11 @@ TEST(SahLeaves, ValidAndNeverDearerThanTheTreeTheyStartFrom) {
         const ValidationReport report = validate(leaves, prims, leaves_up_to(m, wide ? fine.k : 2));
         EXPECT_TRUE(report.ok()) << what << ": " << report.summary();
         EXPECT_LE(sah_cost(leaves), sah_cost(bvh) * (1 + 1e-6)) << what;
-        if (m == 1) EXPECT_EQ(leaves.nodes.size(), bvh.nodes.size()) << what << ": nothing to merge";
-        if (m > 1) EXPECT_LT(leaves.nodes.size(), bvh.nodes.size()) << what << ": nothing merged";
+        if (m == 1) {
+          EXPECT_EQ(leaves.nodes.size(), bvh.nodes.size()) << what << ": nothing to merge";
+        } else {
+          EXPECT_LT(leaves.nodes.size(), bvh.nodes.size()) << what << ": nothing merged";
+        }
       }
     }
   }

@@ -20,17 +20,17 @@ std::string check_params(const BinaryBuildParams& p) {
 
 namespace {
 
-using BuildFunction = Bvh (*)(const PrimitiveSet&, const BinaryBuildParams&, BuildInfo*);
+using BuildFunction = Bvh (*)(const PrimitiveSet&, const BinaryBuildParams&, BuildInfo*, BuildContext*);
 
 Bvh dispatch(BuildFunction cpu, [[maybe_unused]] BuildFunction gpu, const PrimitiveSet& prims,
-             const BinaryBuildParams& params, Backend backend, BuildInfo* info) {
+             const BinaryBuildParams& params, Backend backend, BuildInfo* info, BuildContext* context) {
   if (const std::string problem = check_params(params); !problem.empty()) throw std::invalid_argument(problem);
   require_backend(backend);
   const CountBackendSteps counting(info ? &info->backend : nullptr);
 #if defined(KMBVH_HAS_CUDA)
-  if (backend == Backend::Cuda) return gpu(prims, params, info);
+  if (backend == Backend::Cuda) return gpu(prims, params, info, context);
 #endif
-  return cpu(prims, params, info);
+  return cpu(prims, params, info, context);
 }
 
 #if defined(KMBVH_HAS_CUDA)
@@ -41,17 +41,17 @@ Bvh dispatch(BuildFunction cpu, [[maybe_unused]] BuildFunction gpu, const Primit
 
 }  // namespace
 
-Bvh build_lbvh(const PrimitiveSet& p, const BinaryBuildParams& q, Backend b, BuildInfo* i) {
-  return dispatch(detail::build_lbvh_cpu, KMBVH_GPU(lbvh), p, q, b, i);
+Bvh build_lbvh(const PrimitiveSet& p, const BinaryBuildParams& q, Backend b, BuildInfo* i, BuildContext* c) {
+  return dispatch(detail::build_lbvh_cpu, KMBVH_GPU(lbvh), p, q, b, i, c);
 }
-Bvh build_hlbvh(const PrimitiveSet& p, const BinaryBuildParams& q, Backend b, BuildInfo* i) {
-  return dispatch(detail::build_hlbvh_cpu, KMBVH_GPU(hlbvh), p, q, b, i);
+Bvh build_hlbvh(const PrimitiveSet& p, const BinaryBuildParams& q, Backend b, BuildInfo* i, BuildContext* c) {
+  return dispatch(detail::build_hlbvh_cpu, KMBVH_GPU(hlbvh), p, q, b, i, c);
 }
-Bvh build_atrbvh(const PrimitiveSet& p, const BinaryBuildParams& q, Backend b, BuildInfo* i) {
-  return dispatch(detail::build_atrbvh_cpu, KMBVH_GPU(atrbvh), p, q, b, i);
+Bvh build_atrbvh(const PrimitiveSet& p, const BinaryBuildParams& q, Backend b, BuildInfo* i, BuildContext* c) {
+  return dispatch(detail::build_atrbvh_cpu, KMBVH_GPU(atrbvh), p, q, b, i, c);
 }
-Bvh build_ploc(const PrimitiveSet& p, const BinaryBuildParams& q, Backend b, BuildInfo* i) {
-  return dispatch(detail::build_ploc_cpu, KMBVH_GPU(ploc), p, q, b, i);
+Bvh build_ploc(const PrimitiveSet& p, const BinaryBuildParams& q, Backend b, BuildInfo* i, BuildContext* c) {
+  return dispatch(detail::build_ploc_cpu, KMBVH_GPU(ploc), p, q, b, i, c);
 }
 
 }  // namespace kmbvh

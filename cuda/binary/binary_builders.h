@@ -4,6 +4,7 @@
 #pragma once
 
 #include "../core/backend.h"
+#include "../core/build_context.h"
 #include "../core/build_info.h"
 #include "../core/bvh.h"
 #include "../core/primitive_set.h"
@@ -12,20 +13,24 @@
 namespace kmbvh {
 
 // Each throws std::invalid_argument for parameters check_params() rejects, and
-// std::runtime_error when the backend cannot run.
+// std::runtime_error when the backend cannot run. With a context, the build's buffers and
+// temporaries come from the context's pool and go back to it for the next build
+// (build_context.h); the tree is the same either way.
 Bvh build_lbvh(const PrimitiveSet& prims, const BinaryBuildParams& params, Backend backend = Backend::Cpu,
-               BuildInfo* info = nullptr);
+               BuildInfo* info = nullptr, BuildContext* context = nullptr);
 Bvh build_hlbvh(const PrimitiveSet& prims, const BinaryBuildParams& params, Backend backend = Backend::Cpu,
-                BuildInfo* info = nullptr);
+                BuildInfo* info = nullptr, BuildContext* context = nullptr);
 Bvh build_atrbvh(const PrimitiveSet& prims, const BinaryBuildParams& params, Backend backend = Backend::Cpu,
-                 BuildInfo* info = nullptr);
+                 BuildInfo* info = nullptr, BuildContext* context = nullptr);
 Bvh build_ploc(const PrimitiveSet& prims, const BinaryBuildParams& params, Backend backend = Backend::Cpu,
-               BuildInfo* info = nullptr);
+               BuildInfo* info = nullptr, BuildContext* context = nullptr);
 
 namespace detail {
 #define KMBVH_DECLARE_BINARY_BUILDER(name)                                                             \
-  Bvh build_##name##_cpu(const PrimitiveSet& prims, const BinaryBuildParams& params, BuildInfo* info); \
-  Bvh build_##name##_gpu(const PrimitiveSet& prims, const BinaryBuildParams& params, BuildInfo* info);
+  Bvh build_##name##_cpu(const PrimitiveSet& prims, const BinaryBuildParams& params, BuildInfo* info, \
+                         BuildContext* context);                                                 \
+  Bvh build_##name##_gpu(const PrimitiveSet& prims, const BinaryBuildParams& params, BuildInfo* info, \
+                         BuildContext* context);
 KMBVH_DECLARE_BINARY_BUILDER(lbvh)
 KMBVH_DECLARE_BINARY_BUILDER(hlbvh)
 KMBVH_DECLARE_BINARY_BUILDER(atrbvh)

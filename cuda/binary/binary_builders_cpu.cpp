@@ -9,9 +9,17 @@
 
 namespace kmbvh::detail {
 
-Bvh build_lbvh_cpu(const PrimitiveSet& p, const BinaryBuildParams& q, BuildInfo* i) { return cpu_backend::build_lbvh(p, q, i); }
-Bvh build_hlbvh_cpu(const PrimitiveSet& p, const BinaryBuildParams& q, BuildInfo* i) { return cpu_backend::build_hlbvh(p, q, i); }
-Bvh build_atrbvh_cpu(const PrimitiveSet& p, const BinaryBuildParams& q, BuildInfo* i) { return cpu_backend::build_atrbvh(p, q, i); }
-Bvh build_ploc_cpu(const PrimitiveSet& p, const BinaryBuildParams& q, BuildInfo* i) { return cpu_backend::build_ploc(p, q, i); }
+Bvh build_lbvh_cpu(const PrimitiveSet& p, const BinaryBuildParams& q, BuildInfo* i, BuildContext* c) {
+  return cpu_backend::in_context(c, "binary/cpu", [&] { return cpu_backend::build_lbvh(p, q, i); });
+}
+Bvh build_hlbvh_cpu(const PrimitiveSet& p, const BinaryBuildParams& q, BuildInfo* i, BuildContext* c) {
+  return cpu_backend::in_context(c, "binary/cpu", [&] { return cpu_backend::build_hlbvh(p, q, i); });
+}
+Bvh build_atrbvh_cpu(const PrimitiveSet& p, const BinaryBuildParams& q, BuildInfo* i, BuildContext* c) {
+  return cpu_backend::in_context(c, "binary/cpu", [&] { return cpu_backend::build_atrbvh(p, q, i); });
+}
+Bvh build_ploc_cpu(const PrimitiveSet& p, const BinaryBuildParams& q, BuildInfo* i, BuildContext* c) {
+  return cpu_backend::in_context(c, "binary/cpu", [&] { return cpu_backend::build_ploc(p, q, i); });
+}
 
 }  // namespace kmbvh::detail

@@ -8,9 +8,17 @@
 
 namespace kmbvh::detail {
 
-Bvh build_lbvh_gpu(const PrimitiveSet& p, const BinaryBuildParams& q, BuildInfo* i) { return gpu_backend::build_lbvh(p, q, i); }
-Bvh build_hlbvh_gpu(const PrimitiveSet& p, const BinaryBuildParams& q, BuildInfo* i) { return gpu_backend::build_hlbvh(p, q, i); }
-Bvh build_atrbvh_gpu(const PrimitiveSet& p, const BinaryBuildParams& q, BuildInfo* i) { return gpu_backend::build_atrbvh(p, q, i); }
-Bvh build_ploc_gpu(const PrimitiveSet& p, const BinaryBuildParams& q, BuildInfo* i) { return gpu_backend::build_ploc(p, q, i); }
+Bvh build_lbvh_gpu(const PrimitiveSet& p, const BinaryBuildParams& q, BuildInfo* i, BuildContext* c) {
+  return gpu_backend::in_context(c, "binary/gpu", [&] { return gpu_backend::build_lbvh(p, q, i); });
+}
+Bvh build_hlbvh_gpu(const PrimitiveSet& p, const BinaryBuildParams& q, BuildInfo* i, BuildContext* c) {
+  return gpu_backend::in_context(c, "binary/gpu", [&] { return gpu_backend::build_hlbvh(p, q, i); });
+}
+Bvh build_atrbvh_gpu(const PrimitiveSet& p, const BinaryBuildParams& q, BuildInfo* i, BuildContext* c) {
+  return gpu_backend::in_context(c, "binary/gpu", [&] { return gpu_backend::build_atrbvh(p, q, i); });
+}
+Bvh build_ploc_gpu(const PrimitiveSet& p, const BinaryBuildParams& q, BuildInfo* i, BuildContext* c) {
+  return gpu_backend::in_context(c, "binary/gpu", [&] { return gpu_backend::build_ploc(p, q, i); });
+}
 
 }  // namespace kmbvh::detail

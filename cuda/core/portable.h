@@ -22,9 +22,12 @@
 #include <chrono>
 #include <cstdint>
 #include <map>
+#include <type_traits>
+#include <vector>
 
 #include "aabb.h"
 #include "backend_counters.h"
+#include "build_context.h"
 #include "build_info.h"
 #include "huge_pages.h"
 #if KMBVH_BACKEND_CPU
@@ -34,28 +37,43 @@
 namespace kmbvh {
 namespace KMBVH_BACKEND_NAMESPACE {
 
+class MemoryPool;
+inline thread_local MemoryPool* current_pool = nullptr;  // the build's (UsePool), if any
+
 // Working buffers are not value-initialised: kernels write what they later read, so
 // filling fresh memory with zeros would only cost time (Thrust's uninitialized_allocator idiom).
-// Every allocation is counted (backend_counters.h).
+// A buffer made inside a build that has a pool (UsePool) takes its memory from the pool and
+// gives it back there; any other allocates its own, counted (backend_counters.h) and, on
+// the CPU, on huge pages (huge_pages.h).
 template <typename T>
 struct UninitializedAllocator : thrust::device_allocator<T> {
   using Base = thrust::device_allocator<T>;
+  using pointer = typename Base::pointer;
+  using size_type = typename Base::size_type;
+  using propagate_on_container_copy_assignment = std::true_type;
+  using propagate_on_container_move_assignment = std::true_type;
+  using propagate_on_container_swap = std::true_type;
   template <typename U>
   struct rebind {
     using other = UninitializedAllocator<U>;
   };
   UninitializedAllocator() = default;
   template <typename U>
-  UninitializedAllocator(const UninitializedAllocator<U>&) {}
-  typename Base::pointer allocate(typename Base::size_type n) {
-    count_allocation(n * sizeof(T));
-    const typename Base::pointer p = Base::allocate(n);
-#if KMBVH_BACKEND_CPU
-    advise_huge_pages(thrust::raw_pointer_cast(p), n * sizeof(T));  // host memory: huge_pages.h
-#endif
-    return p;
-  }
+  UninitializedAllocator(const UninitializedAllocator<U>& other) : pool(other.pool) {}
+
+  pointer allocate(size_type n);
+  void deallocate(pointer p, size_type n);
   KMBVH_HD void construct(T*) {}
+  template <typename U>
+  bool operator==(const UninitializedAllocator<U>& other) const {
+    return pool == other.pool;
+  }
+  template <typename U>
+  bool operator!=(const UninitializedAllocator<U>& other) const {
+    return pool != other.pool;
+  }
+
+  MemoryPool* pool = current_pool;
 };
 
 template <typename T>
@@ -81,77 +99,125 @@ size_t bytes_reserved(const Buffer<T>& b) {
   return b.capacity() * sizeof(T);
 }
 
-// Thrust's temporary storage (a scan's partial sums, CUB's scratch space), in blocks kept
-// for the next step and the next build: without it every such step allocates and frees, a
-// cudaMalloc and cudaFree on the GPU. A request no free block holds frees the free ones (all
-// smaller) and allocates anew, so the pool holds what the largest steps need at once. A pool
-// made with keep = false frees each block when it is given back.
-class ScratchPool {
+// Backend memory of one size, fresh from the system: device memory on the GPU, host memory
+// on huge pages on the CPU. Counted.
+inline char* allocate_fresh(size_t bytes) {
+  count_allocation(bytes);
+  char* p = thrust::raw_pointer_cast(thrust::device_malloc<char>(bytes));
+#if KMBVH_BACKEND_CPU
+  advise_huge_pages(p, bytes);
+#endif
+  return p;
+}
+inline void free_fresh(char* p) { thrust::device_free(thrust::device_pointer_cast(p)); }
+
+// Backend memory in blocks kept for reuse: Thrust's temporaries (a scan's partial sums,
+// CUB's scratch space), and the buffers made inside a build that uses the pool (UsePool).
+// Blocks come in power-of-two sizes, go back to their size's free list when given back and
+// are freed only with the pool, so a build asking for what the last one asked (the same
+// sizes, as many at once) takes every block from the lists: no cudaMalloc, no fresh page.
+// As CUB's caching allocator bins its blocks. A pool made with keep = false frees each
+// block when it is given back.
+class MemoryPool {
  public:
   using value_type = char;
-  explicit ScratchPool(bool keep = true) : keep_(keep) {}
-  ScratchPool(const ScratchPool&) = delete;
-  ScratchPool& operator=(const ScratchPool&) = delete;
-  ~ScratchPool() {
-    free_blocks();
-    for (const auto& [p, bytes] : used_) thrust::device_free(thrust::device_pointer_cast(p));
+  explicit MemoryPool(bool keep = true) : keep_(keep) {}
+  MemoryPool(const MemoryPool&) = delete;
+  MemoryPool& operator=(const MemoryPool&) = delete;
+  ~MemoryPool() {
+    for (auto& [size, blocks] : free_)
+      for (char* p : blocks) free_fresh(p);
+    for (const auto& [p, size] : used_) free_fresh(p);
   }
 
   char* allocate(std::ptrdiff_t n) {
-    const size_t bytes = size_t(n);
-    auto it = free_.lower_bound(bytes);
-    if (it == free_.end()) {
-      free_blocks();
-      count_allocation(bytes);
-      held_ += bytes;
-      it = free_.emplace(bytes, thrust::raw_pointer_cast(thrust::device_malloc<char>(bytes)));
+    const size_t size = size_class(size_t(n));
+    std::vector<char*>& blocks = free_[size];
+    char* p;
+    if (blocks.empty()) {
+      p = allocate_fresh(size);
+      held_ += size;
+    } else {
+      p = blocks.back();
+      blocks.pop_back();
     }
-    char* p = it->second;
-    used_.emplace(p, it->first);
-    free_.erase(it);
+    used_.emplace(p, size);
     return p;
   }
   void deallocate(char* p, size_t) {
     const auto it = used_.find(p);
-    free_.emplace(it->second, p);
+    const size_t size = it->second;
     used_.erase(it);
-    if (!keep_) free_blocks();
+    if (keep_) {
+      free_[size].push_back(p);
+    } else {
+      free_fresh(p);
+      held_ -= size;
+    }
   }
   size_t bytes_held() const { return held_; }
 
  private:
-  void free_blocks() {
-    for (const auto& [bytes, p] : free_) {
-      thrust::device_free(thrust::device_pointer_cast(p));
-      held_ -= bytes;
-    }
-    free_.clear();
+  static size_t size_class(size_t n) {
+    size_t size = 256;
+    while (size < n) size <<= 1;
+    return size;
   }
 
   bool keep_;
-  std::multimap<size_t, char*> free_;  // by size
+  std::map<size_t, std::vector<char*>> free_;  // by size
   std::map<char*, size_t> used_;
   size_t held_ = 0;
 };
 
-// The pool this thread's steps take their temporaries from: the build's (UseScratch), or,
-// outside a build that set one, a pool that keeps nothing.
-inline thread_local ScratchPool* current_scratch = nullptr;
-inline ScratchPool& scratch() {
-  if (current_scratch) return *current_scratch;
-  static thread_local ScratchPool passing(/*keep=*/false);
+template <typename T>
+typename UninitializedAllocator<T>::pointer UninitializedAllocator<T>::allocate(size_type n) {
+  if (pool) return pointer(reinterpret_cast<T*>(pool->allocate(std::ptrdiff_t(n * sizeof(T)))));
+  return pointer(reinterpret_cast<T*>(allocate_fresh(n * sizeof(T))));
+}
+template <typename T>
+void UninitializedAllocator<T>::deallocate(pointer p, size_type n) {
+  char* raw = reinterpret_cast<char*>(thrust::raw_pointer_cast(p));
+  if (pool)
+    pool->deallocate(raw, n * sizeof(T));
+  else
+    free_fresh(raw);
+}
+
+// Thrust's temporaries come from the build's pool, or, outside a build that set one, from
+// a pool that keeps nothing.
+inline MemoryPool& scratch() {
+  if (current_pool) return *current_pool;
+  static thread_local MemoryPool passing(/*keep=*/false);
   return passing;
 }
-class UseScratch {
+
+// Makes `pool` the build's while it lives: Thrust's temporaries and every buffer made
+// meanwhile take their memory from it.
+class UsePool {
  public:
-  explicit UseScratch(ScratchPool& pool) : previous_(current_scratch) { current_scratch = &pool; }
-  ~UseScratch() { current_scratch = previous_; }
-  UseScratch(const UseScratch&) = delete;
-  UseScratch& operator=(const UseScratch&) = delete;
+  explicit UsePool(MemoryPool& pool) : previous_(current_pool) { current_pool = &pool; }
+  ~UsePool() { current_pool = previous_; }
+  UsePool(const UsePool&) = delete;
+  UsePool& operator=(const UsePool&) = delete;
 
  private:
-  ScratchPool* previous_;
+  MemoryPool* previous_;
 };
+
+// The memory a builder without buffers of its own keeps in a BuildContext: one pool.
+struct PoolWorkspace : BuildContext::Workspace {
+  MemoryPool pool;
+  size_t bytes_held() const override { return pool.bytes_held(); }
+};
+
+// Runs build() with the pool of `context`'s workspace `key` (none without a context).
+template <typename Build>
+auto in_context(BuildContext* context, const char* key, const Build& build) {
+  if (!context) return build();
+  const UsePool use(context->workspace<PoolWorkspace>(key).pool);
+  return build();
+}
 
 // The execution policy of one parallel step, counted (backend_counters.h): the backend's
 // device system with its temporaries from scratch(). Every Thrust call of a build takes it.

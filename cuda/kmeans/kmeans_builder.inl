@@ -59,7 +59,7 @@ struct IsSplitByIndex {
 // The level loop's memory, kept in a BuildContext from one build to the next: every buffer
 // keeps its capacity, so a build no larger than the last allocates nothing.
 struct KMeansWorkspace : BuildContext::Workspace {
-  ScratchPool scratch;
+  MemoryPool scratch;  // Thrust's temporaries, and the buffers a build makes for itself
   Buffer<Aabb> boxes[2];
   Buffer<uint32_t> ids[2];
   Buffer<uint32_t> final_ids;
@@ -413,7 +413,7 @@ inline Bvh build(const PrimitiveSet& prims, const KMeansParams& params, BuildInf
   const CountBackendSteps counting(info ? &info->backend : nullptr);
   KMeansWorkspace own;
   KMeansWorkspace& ws = context ? context->workspace<KMeansWorkspace>(key) : own;
-  const UseScratch scratch(ws.scratch);
+  const UsePool pool(ws.scratch);
   if (params.metric == ClusterMetric::Means)
     return build_with_metric<ClusterMetric::Means>(prims, params, info, ws, context != nullptr);
   return build_with_metric<ClusterMetric::Medians>(prims, params, info, ws, context != nullptr);
