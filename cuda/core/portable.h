@@ -22,6 +22,7 @@
 #include <chrono>
 #include <cstdint>
 #include <map>
+#include <new>
 #include <type_traits>
 #include <vector>
 
@@ -100,10 +101,11 @@ size_t bytes_reserved(const Buffer<T>& b) {
 }
 
 // Backend memory of one size, fresh from the system: device memory on the GPU, host memory
-// on huge pages on the CPU. Counted.
+// on huge pages on the CPU. Counted; throws std::bad_alloc when there is none.
 inline char* allocate_fresh(size_t bytes) {
   count_allocation(bytes);
   char* p = thrust::raw_pointer_cast(thrust::device_malloc<char>(bytes));
+  if (!p && bytes > 0) throw std::bad_alloc();  // Thrust's malloc returns null when out of memory
 #if KMBVH_BACKEND_CPU
   advise_huge_pages(p, bytes);
 #endif
