@@ -7,6 +7,8 @@
 #include <vector>
 
 #include "cuda/kmeans/assign.h"
+#include "cuda/kmeans/emit.h"
+#include "cuda/kmeans/params.h"
 #include "cuda/kmeans/partition.h"
 #include "cuda/kmeans/setup.h"
 #include "support/printers.h"
@@ -136,11 +138,20 @@ TEST(Partition, SingleClusterIsSplitByIndex) {
   for (uint32_t c = 0; c < s.k; ++c) l.reps[s.cluster_base + c] = l.reps[s.cluster_base];
   for (uint32_t p = 0; p < l.pieces.size(); ++p) AssignPiece<8, ClusterMetric::Means, AssignPass::Final>{l.view()}(p);
   EXPECT_EQ(l.counts[s.cluster_base], s.count);
-  for (uint32_t i = 0; i < 2; ++i) DetectSingleCluster{l.segments.data(), l.clusters()}(i);
+  uint32_t forced = 0;
+  for (uint32_t i = 0; i < 2; ++i) DetectSingleCluster{l.segments.data(), l.clusters(), &forced}(i);
   EXPECT_EQ(l.segments[0].split_by_index, 0u);
   ASSERT_EQ(l.segments[1].split_by_index, 1u);
+  EXPECT_EQ(forced, 1u);  // counted on the device, read once a build
+  // The pass runs over every piece (the level loop does not wait for the count), and leaves
+  // the segments clustering did split as they are.
+  const std::vector<uint8_t> cluster_of = l.cluster_of;
+  const std::vector<uint32_t> counts = l.counts;
   for (uint32_t p = 0; p < l.pieces.size(); ++p)
     AssignPiece<8, ClusterMetric::Means, AssignPass::SplitByIndex>{l.view()}(p);
+  const Segment& a = l.segments[0];
+  for (uint32_t i = a.begin; i < a.begin + a.count; ++i) EXPECT_EQ(l.cluster_of[i], cluster_of[i]);
+  for (uint32_t c = 0; c < a.k; ++c) EXPECT_EQ(l.counts[a.cluster_base + c], counts[a.cluster_base + c]);
   // k runs of (almost) equal length, in order.
   uint32_t total = 0;
   for (uint32_t c = 0; c < s.k; ++c) {
@@ -150,6 +161,41 @@ TEST(Partition, SingleClusterIsSplitByIndex) {
   }
   EXPECT_EQ(total, s.count);
   for (uint32_t i = s.begin + 1; i < s.begin + s.count; ++i) EXPECT_LE(l.cluster_of[i - 1], l.cluster_of[i]);
+}
+
+// The sizes CountChildren adds up for the next level (ChildCounts::next) are those of the
+// segments EmitChildren writes: the next set-up takes them without reading its own scan's
+// total back, so a difference would leave its buffers short.
+TEST(Partition, CountedSizesOfTheNextLevelAreThoseOfTheSegmentsEmitted) {
+  for (const char* preset : {"Q2", "QA"})
+    for (bool wide : {false, true}) {
+      HostLevel l = make_level();
+      for (uint32_t p = 0; p < l.pieces.size(); ++p)
+        AssignPiece<8, ClusterMetric::Means, AssignPass::Final>{l.view()}(p);
+      for (uint32_t s = 0; s < 2; ++s) {
+        PlaceClusters{l.segments.data(), l.pieces.data(), l.counters.data(), l.clusters()}(s);
+        l.segments[s].node = s;
+      }
+      NodeRules rules = node_rules(*kmeans_preset(preset));
+      rules.max_leaf_size = 20;  // some clusters leaves, some split again
+      rules.wide = wide;
+      const SizesOfSegment sizes{16};
+      std::vector<ChildCounts> counts(2), offsets(3);
+      for (uint32_t s = 0; s < 2; ++s) CountChildren{l.segments.data(), l.clusters(), rules, sizes, counts.data()}(s);
+      for (uint32_t s = 0; s < 2; ++s) offsets[s + 1] = AddChildCounts{}(offsets[s], counts[s]);
+      const ChildCounts total = offsets[2];
+      std::vector<BvhNode> nodes(2 + total.nodes);
+      std::vector<Segment> next(total.segments);
+      for (uint32_t s = 0; s < 2; ++s)
+        EmitChildren<8>{l.segments.data(), l.clusters(), rules, offsets.data(), 2, nodes.data(), next.data()}(s);
+      SegmentSizes emitted;
+      for (const Segment& seg : next) emitted = AddSegmentSizes{}(emitted, sizes(seg));
+      const std::string what = std::string(preset) + (wide ? " wide" : "");
+      ASSERT_GT(total.segments, 0u) << what;
+      EXPECT_EQ(total.next.clusters, emitted.clusters) << what;
+      EXPECT_EQ(total.next.pieces, emitted.pieces) << what;
+      EXPECT_EQ(total.next.counters, emitted.counters) << what;
+    }
 }
 
 }  // namespace

@@ -38,7 +38,7 @@ inline void collapse(const BinaryTreeView& tree, CollapseState& state, uint32_t 
 inline Bvh lay_out(const BinaryTreeView& tree, CollapseView view, const uint32_t* range_first = nullptr) {
   const uint32_t n = tree.n;
   Buffer<uint32_t> frontier(1), next_frontier;
-  frontier[0] = tree.root;
+  write(frontier, 0, tree.root);
   Buffer<LevelCounts> counts, offsets;
   Buffer<BvhNode> nodes;
   nodes.reserve(n);
@@ -50,7 +50,7 @@ inline Bvh lay_out(const BinaryTreeView& tree, CollapseView view, const uint32_t
     for_each_index(level, CountLevel{ptr(frontier), view, ptr(counts)});
     thrust::exclusive_scan(launch(), counts.begin(), counts.begin() + level, offsets.begin(), LevelCounts{},
                            AddLevelCounts{});
-    const LevelCounts total = AddLevelCounts{}(offsets[level - 1], counts[level - 1]);
+    const LevelCounts total = AddLevelCounts{}(read(offsets, level - 1), read(counts, level - 1));
     const uint32_t next_base = level_base + level;
     nodes.resize(next_base + total.children);
     grow_to(next_frontier, total.children);

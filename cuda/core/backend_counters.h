@@ -11,8 +11,9 @@ struct BackendCounters {
   // Parallel steps: a kernel launch (or several, for a Thrust algorithm) on the GPU, a
   // parallel loop with its closing barrier on the CPU.
   uint64_t launches = 0;
-  // Times the host waited for the device: a step the host blocks on until it is done, a
-  // value read back (a count, a scan's total), a copy to the host.
+  // Times the host waited for the device: a value read back (a count, a scan's total, a
+  // reduction), a copy to or from the host. Steps are issued without waiting (par_nosync
+  // on the GPU), so these are the round trips a build makes.
   uint64_t host_syncs = 0;
   // Backend memory allocated: working buffers grown, and the temporary storage Thrust asks
   // for (scan partials, CUB's scratch). On the GPU each is a cudaMalloc.
@@ -47,10 +48,9 @@ class CountBackendSteps {
   BackendCounters* previous_;
 };
 
-// A step that blocks the host until it is done (every Thrust algorithm on the thrust::device
-// policy does), or a value read back: what the backend's steps call.
+// What the backend's steps call: a parallel step issued, the host waiting for the device.
 inline void count_launch() {
-  if (BackendCounters* c = detail::counted_backend()) ++c->launches, ++c->host_syncs;
+  if (BackendCounters* c = detail::counted_backend()) ++c->launches;
 }
 inline void count_host_sync() {
   if (BackendCounters* c = detail::counted_backend()) ++c->host_syncs;

@@ -18,6 +18,9 @@
 #include <thrust/iterator/counting_iterator.h>
 #include <thrust/reduce.h>
 #include <thrust/sort.h>
+#if !KMBVH_BACKEND_CPU
+#include <thrust/system/cuda/execution_policy.h>  // par_nosync
+#endif
 
 #include <chrono>
 #include <cstdint>
@@ -221,11 +224,27 @@ auto in_context(BuildContext* context, const char* key, const Build& build) {
   return build();
 }
 
-// The execution policy of one parallel step, counted (backend_counters.h): the backend's
-// device system with its temporaries from scratch(). Every Thrust call of a build takes it.
+// The execution policy of one parallel step, counted (backend_counters.h), with its
+// temporaries from scratch(). On the GPU the host does not wait for it (par_nosync: the
+// steps of a level queue up on the stream, and the host waits only where it reads a value
+// back); on the CPU each is a parallel loop that ends with its barrier. Every Thrust call of
+// a build takes launch(), or launch_and_read() for a step whose result the host reads (a
+// reduction, a count), which waits.
+inline auto policy() {
+#if KMBVH_BACKEND_CPU
+  return thrust::device(scratch());
+#else
+  return thrust::cuda::par_nosync(scratch());
+#endif
+}
 inline auto launch() {
   count_launch();
-  return thrust::device(scratch());
+  return policy();
+}
+inline auto launch_and_read() {
+  count_launch();
+  count_host_sync();
+  return policy();
 }
 
 template <typename F>
@@ -301,7 +320,7 @@ struct JoinBoxes {
 };
 
 inline Aabb bounds_of(Buffer<Aabb>& boxes, size_t n) {
-  return thrust::reduce(launch(), boxes.begin(), boxes.begin() + n, Aabb::empty(), JoinBoxes{});
+  return thrust::reduce(launch_and_read(), boxes.begin(), boxes.begin() + n, Aabb::empty(), JoinBoxes{});
 }
 
 // Sorts (key, value) pairs by key, stably. The GPU uses Thrust (CUB's radix sort); the CPU
@@ -319,7 +338,8 @@ inline void sort_pairs(Buffer<unsigned long long>& keys, Buffer<uint32_t>& value
 #endif
 }
 
-// Times phases on the host; every Thrust algorithm used here blocks until it is done.
+#if KMBVH_BACKEND_CPU
+// Times phases on the host: every parallel loop has ended when its call returns.
 class PhaseClock {
  public:
   explicit PhaseClock(BuildInfo* info) : info_(info), last_(std::chrono::steady_clock::now()) {}
@@ -333,6 +353,39 @@ class PhaseClock {
   BuildInfo* info_;
   std::chrono::steady_clock::time_point last_;
 };
+#else
+// Times phases on the device, where the steps run behind the host (launch()): an event
+// recorded on the stream at every lap, and the times between them added to the build's
+// phases when the clock goes, after the build has waited for its tree.
+class PhaseClock {
+ public:
+  explicit PhaseClock(BuildInfo* info) : info_(info) { record(""); }
+  ~PhaseClock() {
+    if (info_ && events_.size() > 1 && cudaEventSynchronize(events_.back().second) == cudaSuccess) {
+      for (size_t i = 1; i < events_.size(); ++i) {
+        float ms = 0;
+        if (cudaEventElapsedTime(&ms, events_[i - 1].second, events_[i].second) == cudaSuccess)
+          info_->add_phase(events_[i].first, ms);
+      }
+    }
+    for (const auto& [phase, event] : events_) cudaEventDestroy(event);
+  }
+  PhaseClock(const PhaseClock&) = delete;
+  PhaseClock& operator=(const PhaseClock&) = delete;
+  void lap(const char* phase) { record(phase); }
+
+ private:
+  void record(const char* phase) {
+    if (!info_) return;
+    cudaEvent_t event;
+    if (cudaEventCreate(&event) != cudaSuccess) return;
+    cudaEventRecord(event, 0);
+    events_.emplace_back(phase, event);
+  }
+  BuildInfo* info_;
+  std::vector<std::pair<const char*, cudaEvent_t>> events_;
+};
+#endif
 
 }  // namespace KMBVH_BACKEND_NAMESPACE
 }  // namespace kmbvh

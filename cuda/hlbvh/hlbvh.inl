@@ -27,9 +27,9 @@ inline void rebuild_top(BinaryTreeView& tree, Buffer<uint32_t>& parent, Buffer<C
                         Buffer<uint32_t>& free_nodes, uint32_t cluster_count) {
   Buffer<TopSegment> segments(1), next;
   Buffer<uint32_t> mid, counts, offsets;
-  tree.root = free_nodes[0];
-  segments[0] = TopSegment{0, cluster_count, tree.root};
-  parent[tree.root] = kNoParent;
+  tree.root = read(free_nodes, 0);
+  write(segments, 0, TopSegment{0, cluster_count, tree.root});
+  write(parent, tree.root, kNoParent);
   uint32_t level = 1, free_base = 1;
   while (level > 0) {
     grow_to(mid, level);
@@ -38,7 +38,7 @@ inline void rebuild_top(BinaryTreeView& tree, Buffer<uint32_t>& parent, Buffer<C
     for_each_index(level, ChooseTopSplit{ptr(segments), ptr(clusters), ptr(mid)});
     for_each_index(level, CountTopChildren{ptr(segments), ptr(mid), ptr(counts)});
     thrust::exclusive_scan(launch(), counts.begin(), counts.begin() + level, offsets.begin());
-    const uint32_t total = offsets[level - 1] + counts[level - 1];
+    const uint32_t total = read(offsets, level - 1) + read(counts, level - 1);
     grow_to(next, total);
     for_each_index(level, LinkTopSegment{ptr(segments), ptr(mid), ptr(offsets), ptr(clusters), ptr(free_nodes),
                                          free_base, tree, ptr(next)});
@@ -61,7 +61,7 @@ inline Bvh build_hlbvh(const PrimitiveSet& prims, const BinaryBuildParams& param
   Buffer<uint32_t> starts(n), index(n);
   for_each_index(n, MarkClusterStarts{ptr(radix.codes), ptr(starts)});
   thrust::inclusive_scan(launch(), starts.begin(), starts.end(), index.begin());
-  const uint32_t cluster_count = index[n - 1];
+  const uint32_t cluster_count = read(index, n - 1);
   if (cluster_count > 1) {
     Buffer<uint32_t> cluster_first(cluster_count), top(n - 1), free_nodes(cluster_count - 1);
     Buffer<Cluster> clusters(cluster_count);
@@ -70,7 +70,7 @@ inline Bvh build_hlbvh(const PrimitiveSet& prims, const BinaryBuildParams& param
     for_each_index(n - 1, FindClusterRoots{ptr(index), ptr(radix.range_first), ptr(radix.range_last), tree,
                                            ptr(clusters), ptr(top)});
     const auto ids = thrust::make_transform_iterator(thrust::counting_iterator<uint32_t>(0), InnerNodeId{n});
-    thrust::copy_if(launch(), ids, ids + (n - 1), top.begin(), free_nodes.begin(), IsSet{});
+    thrust::copy_if(launch_and_read(), ids, ids + (n - 1), top.begin(), free_nodes.begin(), IsSet{});
     release(starts, index, cluster_first, top, radix.codes, radix.range_first, radix.range_last);
     clock.lap("groups");
     rebuild_top(tree, radix.parent, clusters, free_nodes, cluster_count);

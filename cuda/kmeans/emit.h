@@ -10,18 +10,23 @@
 #include "agglomerate.h"
 #include "level.h"
 #include "node_rules.h"
+#include "setup.h"
 
 namespace kmbvh {
 
-// How many nodes and next-level segments a segment adds; scanned into output offsets.
+// How many nodes and next-level segments a segment adds, scanned into output offsets; and
+// the sizes of those segments (SizesOfSegment), so that the scan's total also tells the
+// next level's set-up how much room its segments take, and one value read back per level
+// does for both.
 struct ChildCounts {
   uint32_t nodes = 0;
   uint32_t segments = 0;
+  SegmentSizes next;
 };
 
 struct AddChildCounts {
   KMBVH_HD ChildCounts operator()(const ChildCounts& a, const ChildCounts& b) const {
-    return {a.nodes + b.nodes, a.segments + b.segments};
+    return {a.nodes + b.nodes, a.segments + b.segments, AddSegmentSizes{}(a.next, b.next)};
   }
 };
 
@@ -29,18 +34,22 @@ struct CountChildren {
   const Segment* segments;
   ClusterArrays clusters;
   NodeRules rules;
+  SizesOfSegment sizes;
   ChildCounts* out;
 
   KMBVH_HD void operator()(uint32_t s) const {
     const Segment seg = segments[s];
     uint32_t non_empty = 0, splittable = 0;
+    SegmentSizes next;
     for (uint32_t c = 0; c < seg.k; ++c) {
       const uint32_t n = clusters.counts[seg.cluster_base + c];
       non_empty += n != 0;
-      splittable += n > rules.max_leaf_size;
+      if (n <= rules.max_leaf_size) continue;
+      ++splittable;
+      next = AddSegmentSizes{}(next, sizes(n, rules.child_k(n)));  // the segment EmitChildren writes
     }
     // A binary treelet over j children adds its j - 2 inner nodes and the j children.
-    out[s] = {rules.wide ? non_empty : 2 * non_empty - 2, splittable};
+    out[s] = {rules.wide ? non_empty : 2 * non_empty - 2, splittable, next};
   }
 };
 

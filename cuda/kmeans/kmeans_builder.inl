@@ -52,10 +52,6 @@
 namespace kmbvh {
 namespace KMBVH_BACKEND_NAMESPACE {
 
-struct IsSplitByIndex {
-  KMBVH_HD bool operator()(const Segment& s) const { return s.split_by_index != 0; }
-};
-
 // The level loop's memory, kept in a BuildContext from one build to the next: every buffer
 // keeps its capacity, so a build no larger than the last allocates nothing.
 struct KMeansWorkspace : BuildContext::Workspace {
@@ -75,6 +71,7 @@ struct KMeansWorkspace : BuildContext::Workspace {
   Buffer<uint32_t> cluster_begin;
   Buffer<uint32_t> cluster_segment;
   Buffer<ChildCounts> child_counts, child_offsets;
+  Buffer<uint32_t> forced;  // segments split by index, counted on the device
   Buffer<BvhNode> nodes;
   // Host memory of the finishing step: the nodes as built, and the breadth-first order's scratch.
   std::vector<BvhNode> built_nodes;
@@ -88,7 +85,7 @@ struct KMeansWorkspace : BuildContext::Workspace {
            bytes_reserved(pieces) + bytes_reserved(piece_counters) + bytes_reserved(reps) + bytes_reserved(sums) +
            bytes_reserved(counts) + bytes_reserved(bounds) + bytes_reserved(cluster_begin) +
            bytes_reserved(cluster_segment) + bytes_reserved(child_counts) + bytes_reserved(child_offsets) +
-           bytes_reserved(nodes);
+           bytes_reserved(forced) + bytes_reserved(nodes);
   }
 };
 
@@ -104,6 +101,13 @@ class KMeansLevels {
     boxes_[1].resize(n_);
     ids_[0].resize(n_);
     thrust::sequence(launch(), ids_[0].begin(), ids_[0].end());
+    // The zeros before the inclusive scans of set_up and emit, and the forced-split count.
+    grow_to(segment_offsets_, 1);
+    grow_to(child_offsets_, 1);
+    forced_.resize(1);
+    thrust::fill_n(launch(), segment_offsets_.begin(), 1, SegmentSizes{});
+    thrust::fill_n(launch(), child_offsets_.begin(), 1, ChildCounts{});
+    thrust::fill_n(launch(), forced_.begin(), 1, 0u);
     ids_[1].resize(n_);
     final_ids_.resize(n_);
     cluster_of_.resize(n_);
@@ -121,6 +125,7 @@ class KMeansLevels {
     root.box = root_box;
     segments_.resize(1);
     write(segments_, 0, root);
+    sizes_ = SizesOfSegment{KMBVH_PIECE_SIZE}(root);
     uint32_t segment_count = 1;
     clock_.lap("setup");
 
@@ -174,25 +179,25 @@ class KMeansLevels {
     clear_clusters(clusters, false);
     for_each_index(piece_count_, AssignPiece<KMax, M, AssignPass::Final>{view()});
     clock_.lap("assign");
-    for_each_index(segment_count, DetectSingleCluster{ptr(segments_), this->clusters()});
-    const auto forced = thrust::count_if(launch(), segments_.begin(),
-                                         segments_.begin() + segment_count, IsSplitByIndex{});
-    if (forced > 0) {
-      for_each_index(piece_count_, AssignPiece<KMax, M, AssignPass::SplitByIndex>{view()});
-      if (info_) info_->forced_splits += static_cast<uint32_t>(forced);
-    }
+    // The guaranteed split, where clustering made none: counted on the device, and the pass
+    // run whatever the count (its pieces of other segments return at once), so that the
+    // host need not wait for the count.
+    for_each_index(segment_count, DetectSingleCluster{ptr(segments_), this->clusters(), ptr(forced_)});
+    for_each_index(piece_count_, AssignPiece<KMax, M, AssignPass::SplitByIndex>{view()});
     partition(segment_count, /*gather_only=*/false);
     return emit(segment_count);
   }
 
   // Offsets of every segment's clusters, pieces and counters; returns the cluster count.
+  // An inclusive scan after the zero at offsets[0] (written once, in the constructor) gives
+  // every segment's offset. The total is known without reading it back: the previous
+  // level's emit counted it (ChildCounts::next), or the host wrote the segments.
   uint32_t set_up(uint32_t segment_count) {
     const SizesOfSegment sizes{KMBVH_PIECE_SIZE};
-    grow_to(segment_offsets_, segment_count);
-    thrust::transform_exclusive_scan(launch(), segments_.begin(), segments_.begin() + segment_count,
-                                     segment_offsets_.begin(), sizes, SegmentSizes{}, AddSegmentSizes{});
-    const SegmentSizes total =
-        AddSegmentSizes{}(read(segment_offsets_, segment_count - 1), sizes(read(segments_, segment_count - 1)));
+    grow_to(segment_offsets_, segment_count + 1);
+    thrust::transform_inclusive_scan(launch(), segments_.begin(), segments_.begin() + segment_count,
+                                     segment_offsets_.begin() + 1, sizes, AddSegmentSizes{});
+    const SegmentSizes total = sizes_;
     piece_count_ = total.pieces;
     grow_to(pieces_, total.pieces);
     grow_to(piece_counters_, total.counters);
@@ -213,7 +218,7 @@ class KMeansLevels {
   // pieces (AssignPiece), a median update their clusters (UpdateMedians).
   bool all_stable(uint32_t segment_count, uint32_t iteration) {
     for_each_index(segment_count, MarkStable{ptr(segments_), rules(), iteration});
-    return thrust::count_if(launch(), segments_.begin(), segments_.begin() + segment_count, IsUnstable{}) == 0;
+    return thrust::count_if(launch_and_read(), segments_.begin(), segments_.begin() + segment_count, IsUnstable{}) == 0;
   }
 
   void clear_clusters(uint32_t clusters, bool sums) {
@@ -237,14 +242,17 @@ class KMeansLevels {
     clock_.lap("partition");
   }
 
+  // The children's offsets as set_up's: an inclusive scan after a zero, and the total read
+  // back, the level's one wait for the device: the nodes and segments it adds, and the
+  // sizes of those segments for the next set_up.
   uint32_t emit(uint32_t segment_count) {
     grow_to(child_counts_, segment_count);
-    grow_to(child_offsets_, segment_count);
-    for_each_index(segment_count, CountChildren{ptr(segments_), clusters(), rules(), ptr(child_counts_)});
-    thrust::exclusive_scan(launch(), child_counts_.begin(), child_counts_.begin() + segment_count,
-                           child_offsets_.begin(), ChildCounts{}, AddChildCounts{});
-    const ChildCounts total =
-        AddChildCounts{}(read(child_offsets_, segment_count - 1), read(child_counts_, segment_count - 1));
+    grow_to(child_offsets_, segment_count + 1);
+    for_each_index(segment_count, CountChildren{ptr(segments_), clusters(), rules(), SizesOfSegment{KMBVH_PIECE_SIZE},
+                                                ptr(child_counts_)});
+    thrust::inclusive_scan(launch(), child_counts_.begin(), child_counts_.begin() + segment_count,
+                           child_offsets_.begin() + 1, AddChildCounts{});
+    const ChildCounts total = read(child_offsets_, segment_count);
     nodes_.resize(node_count_ + total.nodes);
     grow_to(next_segments_, total.segments);
     // The two segment buffers trade places every level, so that a rebuild, whose levels may
@@ -253,6 +261,7 @@ class KMeansLevels {
     for_each_index(segment_count, EmitChildren<KMax>{ptr(segments_), clusters(), rules(), ptr(child_offsets_),
                                                      node_count_, ptr(nodes_), ptr(next_segments_)});
     node_count_ += total.nodes;
+    sizes_ = total.next;
     std::swap(segments_, next_segments_);
     clock_.lap("agglomerate");
     return total.segments;
@@ -266,11 +275,14 @@ class KMeansLevels {
     Segment* segments = ptr(segments_);
     std::vector<Segment> small;
     uint32_t kept = 0;
+    sizes_ = SegmentSizes{};  // of the segments kept
     for (uint32_t s = 0; s < segment_count; ++s) {
-      if (segments[s].count <= KMBVH_PIECE_SIZE)
+      if (segments[s].count <= KMBVH_PIECE_SIZE) {
         small.push_back(segments[s]);
-      else
+      } else {
+        sizes_ = AddSegmentSizes{}(sizes_, SizesOfSegment{KMBVH_PIECE_SIZE}(segments[s]));
         segments[kept++] = segments[s];
+      }
     }
     if (small.empty()) return kept;
     std::vector<SubtreeNodes> done(small.size());
@@ -355,6 +367,7 @@ class KMeansLevels {
     Bvh bvh;
     bvh.prim_indices = to_host(final_ids_, n_);
     if (!keep_) release(final_ids_);
+    if (info_) info_->forced_splits += read(forced_, 0);
     bvh.nodes = breadth_first_nodes(built.data(), total, ws_.order_scratch);
     clock_.lap("finish");
     return bvh;
@@ -390,8 +403,10 @@ class KMeansLevels {
 
   Buffer<ChildCounts>& child_counts_ = ws_.child_counts;
   Buffer<ChildCounts>& child_offsets_ = ws_.child_offsets;
+  Buffer<uint32_t>& forced_ = ws_.forced;
   Buffer<BvhNode>& nodes_ = ws_.nodes;
   uint32_t node_count_ = 0;
+  SegmentSizes sizes_;  // what the current level's segments take in all (set_up)
 };
 
 template <ClusterMetric M>

@@ -18,6 +18,7 @@ namespace kmbvh {
 struct DetectSingleCluster {
   Segment* segments;
   ClusterArrays clusters;
+  uint32_t* forced = nullptr;  // when set, counts the segments split by index
 
   KMBVH_HD void operator()(uint32_t s) const {
     Segment& seg = segments[s];
@@ -25,6 +26,7 @@ struct DetectSingleCluster {
     for (uint32_t c = 0; c < seg.k; ++c) non_empty += clusters.counts[seg.cluster_base + c] != 0;
     seg.split_by_index = non_empty < 2;
     if (!seg.split_by_index) return;
+    if (forced) atomic_add(forced, 1u);
     for (uint32_t c = 0; c < seg.k; ++c) {
       clusters.counts[seg.cluster_base + c] = 0;
       clusters.bounds[seg.cluster_base + c] = OrderedBounds::empty();

@@ -26,10 +26,11 @@ struct SizesOfSegment {
   uint32_t piece_size;
 
   KMBVH_HD uint32_t pieces(uint32_t count) const { return (count + piece_size - 1) / piece_size; }
-  KMBVH_HD SegmentSizes operator()(const Segment& s) const {
-    const uint32_t q = pieces(s.count);
-    return {s.k, q, q * s.k};
+  KMBVH_HD SegmentSizes operator()(uint32_t count, uint32_t k) const {
+    const uint32_t q = pieces(count);
+    return {k, q, q * k};
   }
+  KMBVH_HD SegmentSizes operator()(const Segment& s) const { return (*this)(s.count, s.k); }
 };
 
 struct SetupSegment {

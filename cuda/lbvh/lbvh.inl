@@ -62,7 +62,7 @@ inline void build_morton_radix_tree(const PrimitiveSet& prims, MortonRadixTree& 
     build.range_last = ptr(t.range_last);
   }
   for_each_index(t.n, build);
-  t.root = root[0];
+  t.root = read(root, 0);
   clock.lap("radix tree");
 }
 

@@ -11,7 +11,7 @@ namespace kmbvh {
 namespace KMBVH_BACKEND_NAMESPACE {
 
 inline void morton_order(const Aabb* boxes, uint32_t n, Buffer<unsigned long long>& codes, Buffer<uint32_t>& order) {
-  const Aabb centroids = thrust::transform_reduce(launch(), boxes, boxes + n, CentroidBox{}, Aabb::empty(),
+  const Aabb centroids = thrust::transform_reduce(launch_and_read(), boxes, boxes + n, CentroidBox{}, Aabb::empty(),
                                                   JoinBoxes{});
   codes.resize(n);
   order.resize(n);

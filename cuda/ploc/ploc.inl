@@ -81,7 +81,7 @@ inline Bvh build_ploc(const PrimitiveSet& prims, const BinaryBuildParams& params
     for_each_index(count, CountMerges{ptr(nearest), ptr(counts)});
     thrust::exclusive_scan(launch(), counts.begin(), counts.begin() + count, offsets.begin(), MergeCounts{},
                            AddMergeCounts{});
-    const MergeCounts total = AddMergeCounts{}(offsets[count - 1], counts[count - 1]);
+    const MergeCounts total = AddMergeCounts{}(read(offsets, count - 1), read(counts, count - 1));
     for_each_index(count, MergeAndCompact{ptr(clusters), cluster_box, ptr(nearest), ptr(offsets), next_inner, tree,
                                           ptr(next_clusters), next_box});
     std::swap(clusters, next_clusters);
@@ -90,8 +90,8 @@ inline Bvh build_ploc(const PrimitiveSet& prims, const BinaryBuildParams& params
     stalled = !stalled && total.merges * kPlocStallFraction < count;
     count = total.kept;
   }
-  tree.root = clusters[0];
-  parent[tree.root] = kNoParent;
+  tree.root = read(clusters, 0);
+  write(parent, tree.root, kNoParent);
   release(clusters, next_clusters, nearest, counts, offsets, box_columns[0], box_columns[1]);
   clock.lap("clustering");
   collapse(tree, state, params.max_leaf_size, params.sah, /*refit=*/false);
