@@ -112,9 +112,11 @@ BuilderConfig builder_for(const PluginConfig& config, RTCBuildQuality quality) {
     return b;
   }
   std::string preset = config.preset;
-  // HIGH asks for the best tree: the adaptive preset, which reaches Q5's SAH cost (within
-  // 2%) in a third to a half of its time (docs/results.md).
-  if (preset.empty()) preset = quality == RTC_BUILD_QUALITY_LOW ? "Q1" : quality == RTC_BUILD_QUALITY_HIGH ? "QA" : "Q3";
+  // Chosen by measurement (scripts/quality_table.py, the table in plugin/README.md): LOW and
+  // MEDIUM take the k-means configuration nearest to dominating Embree's build of that
+  // quality on the shared scenes; HIGH, where Embree's rtcBuildBVH builds MEDIUM's tree in
+  // MEDIUM's time, the one with the lowest SAH cost, the faster of equals.
+  if (preset.empty()) preset = quality == RTC_BUILD_QUALITY_LOW ? "Q1" : quality == RTC_BUILD_QUALITY_HIGH ? "Q3S" : "Q2S";
   BuilderConfig b = parse_builder("kmeans:" + preset);
   if (config.k || config.p || config.i) b.preset.clear();
   if (config.k) b.kmeans.k = config.k;

@@ -54,8 +54,8 @@ PluginConfig read_plugin_config();
 // defaults are used.
 const PluginConfig& plugin_config();
 
-// The builder for one build of the given quality (LOW: Q1, MEDIUM: Q3, HIGH: QA for
-// k-means, unless KMBVH_PRESET/K/P/I say otherwise).
+// The builder for one build of the given quality (LOW: Q1, MEDIUM: Q2S, HIGH: Q3S for
+// k-means, unless KMBVH_PRESET/K/P/I say otherwise; plugin/README.md has the table).
 BuilderConfig builder_for(const PluginConfig& config, RTCBuildQuality quality);
 
 // KMBVH_LOG lines go through here (stderr, one write per line).
