@@ -107,7 +107,7 @@ void* build(BvhObject& object, const RTCBuildArguments& a) {
     ~Emitting() { object.set_emitting(false); }
   } emitting(object);
   try {
-    emitted = emit_to_callbacks(bvh, prims, a.primitives, limits, callbacks, allocators);
+    emitted = emit_to_callbacks(bvh, prims, a.primitives, limits, callbacks, allocators, &object.build_context());
   } catch (const DepthLimitError& e) {
     throw EmbreeError(RTC_ERROR_UNKNOWN, e.what());
   }

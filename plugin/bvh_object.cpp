@@ -47,6 +47,9 @@ BvhObject* BvhObject::from(RTCBVH handle) {
 
 void BvhObject::start_build(size_t threads, size_t primitives) {
   std::lock_guard<std::mutex> lock(blocks_mutex_);
+  // The last tree's blocks become spares for this one; spares it did not need are freed,
+  // so an object holds at most one tree's memory between builds.
+  spare_ = std::move(blocks_);
   blocks_.clear();
   arenas_.clear();
   for (size_t t = 0; t < threads; ++t) arenas_.push_back(std::make_unique<Arena>(this));
@@ -56,12 +59,27 @@ void BvhObject::start_build(size_t threads, size_t primitives) {
 
 std::pair<char*, size_t> BvhObject::new_block(size_t at_least) {
   const size_t n = std::max(at_least, block_bytes_);
-  std::unique_ptr<char[]> block(new char[n]);  // not zeroed: the callbacks write what they use
-  char* p = block.get();
-  advise_huge_pages(p, n);
+  {
+    std::lock_guard<std::mutex> lock(blocks_mutex_);
+    for (size_t i = 0; i < spare_.size(); ++i) {
+      if (spare_[i].bytes < n) continue;
+      Block& b = blocks_.emplace_back(std::move(spare_[i]));
+      spare_[i] = std::move(spare_.back());
+      spare_.pop_back();
+      return {b.memory.get(), b.bytes};
+    }
+  }
+  // Not zeroed (the callbacks write what they use); blocks of 2 MiB or more on whole huge
+  // pages, aligned to them.
+  constexpr size_t kHugePage = size_t(2) << 20;
+  const size_t align = n >= kHugePage ? kHugePage : 64;
+  const size_t bytes = (n + align - 1) / align * align;
+  char* p = static_cast<char*>(std::aligned_alloc(align, bytes));
+  if (!p) throw std::bad_alloc();
+  advise_huge_pages(p, bytes);
   std::lock_guard<std::mutex> lock(blocks_mutex_);
-  blocks_.push_back(std::move(block));
-  return {p, n};
+  blocks_.push_back(Block{std::unique_ptr<char, FreeBlock>(p), bytes});
+  return {p, bytes};
 }
 
 }  // namespace kmbvh::plugin

@@ -9,8 +9,35 @@
 #include <exception>
 #include <mutex>
 
+#include "cuda/core/huge_pages.h"
+
 namespace kmbvh {
+
+// The emitter's per-node arrays and its copy of the primitives, kept in the RTCBVH's build
+// context from one build to the next: for 2.3 million primitives they are about 170 MB,
+// whose first touches cost more than the callbacks themselves on this project's machines
+// (docs/design.md §3). On huge pages when they grow.
+struct EmitWorkspace : BuildContext::Workspace {
+  std::vector<uint32_t> count, first, height;
+  std::vector<double> cost;
+  std::vector<uint8_t> as_leaf;
+  std::vector<RTCBuildPrimitive> original;
+
+  size_t bytes_held() const override {
+    return (count.capacity() + first.capacity() + height.capacity()) * sizeof(uint32_t) +
+           cost.capacity() * sizeof(double) + as_leaf.capacity() + original.capacity() * sizeof(RTCBuildPrimitive);
+  }
+};
+
 namespace {
+
+// v.assign(n, value), the storage on huge pages when it grows.
+template <typename T>
+void assign_on_huge_pages(std::vector<T>& v, size_t n, const T& value) {
+  v.clear();
+  reserve_on_huge_pages(v, n);
+  v.assign(n, value);
+}
 
 constexpr uint32_t kMaxBranching = 16;       // the widest node Embree 3 makes
 constexpr uint32_t kTaskPrimitives = 4096;   // subtrees this large are emitted as tasks of their own
@@ -24,8 +51,8 @@ Aabb range_box(const RTCBuildPrimitive* p, size_t n) {
 class Emitter {
  public:
   Emitter(const Bvh& bvh, RTCBuildPrimitive* out, const EmitLimits& limits, const EmbreeCallbacks& callbacks,
-          const std::vector<RTCThreadLocalAllocator>& allocators)
-      : bvh_(bvh), out_(out), limits_(limits), callbacks_(callbacks), allocators_(allocators) {}
+          const std::vector<RTCThreadLocalAllocator>& allocators, EmitWorkspace& ws)
+      : bvh_(bvh), out_(out), limits_(limits), callbacks_(callbacks), allocators_(allocators), ws_(ws) {}
 
   EmitResult run(const PrimitiveSet& prims) {
     plan();
@@ -65,10 +92,10 @@ class Emitter {
     // Without that, leaves come out larger than Embree's for the same constants.
     binary_traversal_cost_ = double(limits_.traversal_cost) / double(limits_.branching - 1);
     const size_t n = bvh_.nodes.size();
-    count_.assign(n, 0);
-    height_.assign(n, 1);
-    as_leaf_.assign(n, 0);
-    cost_.assign(n, 0.0);
+    assign_on_huge_pages(count_, n, 0u);
+    assign_on_huge_pages(height_, n, 1u);
+    assign_on_huge_pages(as_leaf_, n, uint8_t(0));
+    assign_on_huge_pages(cost_, n, 0.0);
     for (size_t v = n; v-- > 0;) {
       const BvhNode& node = bvh_.nodes[v];
       const double leaf_cost_per_prim = double(limits_.intersection_cost) * node.box.surface_area();
@@ -103,7 +130,7 @@ class Emitter {
   // there in leaf order (the array is the application's; Embree reorders it too).
   void reorder(size_t n) {
     const size_t nodes = bvh_.nodes.size();
-    first_.assign(nodes, 0);
+    assign_on_huge_pages(first_, nodes, 0u);
     for (size_t v = 0; v < nodes; ++v) {
       const BvhNode& node = bvh_.nodes[v];
       if (node.is_leaf()) continue;
@@ -113,7 +140,10 @@ class Emitter {
         at += count_[c];
       }
     }
-    const std::vector<RTCBuildPrimitive> original(out_, out_ + n);
+    std::vector<RTCBuildPrimitive>& original = ws_.original;
+    original.clear();
+    reserve_on_huge_pages(original, n);
+    original.insert(original.end(), out_, out_ + n);
 #pragma omp parallel for schedule(dynamic, 4096)
     for (size_t v = 0; v < nodes; ++v) {
       const BvhNode& node = bvh_.nodes[v];
@@ -272,9 +302,12 @@ class Emitter {
   const EmbreeCallbacks& callbacks_;
   const std::vector<RTCThreadLocalAllocator>& allocators_;
 
-  std::vector<uint32_t> count_, first_, height_;
-  std::vector<double> cost_;
-  std::vector<uint8_t> as_leaf_;
+  EmitWorkspace& ws_;
+  std::vector<uint32_t>& count_ = ws_.count;
+  std::vector<uint32_t>& first_ = ws_.first;
+  std::vector<uint32_t>& height_ = ws_.height;
+  std::vector<double>& cost_ = ws_.cost;
+  std::vector<uint8_t>& as_leaf_ = ws_.as_leaf;
 
   EmitResult result_;
   double binary_traversal_cost_ = 0;
@@ -288,7 +321,7 @@ class Emitter {
 
 EmitResult emit_to_callbacks(const Bvh& bvh, const PrimitiveSet& prims, RTCBuildPrimitive* primitives,
                              const EmitLimits& limits, const EmbreeCallbacks& callbacks,
-                             const std::vector<RTCThreadLocalAllocator>& allocators) {
+                             const std::vector<RTCThreadLocalAllocator>& allocators, BuildContext* context) {
   if (prims.empty() || bvh.empty()) {
     // Embree's answer for no primitives: one empty leaf.
     EmitResult r;
@@ -300,7 +333,9 @@ EmitResult emit_to_callbacks(const Bvh& bvh, const PrimitiveSet& prims, RTCBuild
   EmitLimits clamped = limits;
   clamped.branching = std::clamp<uint32_t>(limits.branching, 2, kMaxBranching);
   clamped.max_leaf = std::max<uint32_t>(limits.max_leaf, 1);
-  return Emitter(bvh, primitives, clamped, callbacks, allocators).run(prims);
+  EmitWorkspace fresh;
+  EmitWorkspace& ws = context ? context->workspace<EmitWorkspace>("emit/callbacks") : fresh;
+  return Emitter(bvh, primitives, clamped, callbacks, allocators, ws).run(prims);
 }
 
 }  // namespace kmbvh

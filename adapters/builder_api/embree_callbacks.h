@@ -20,6 +20,7 @@
 #include <stdexcept>
 #include <vector>
 
+#include "cuda/core/build_context.h"
 #include "cuda/core/bvh.h"
 #include "cuda/core/primitive_set.h"
 
@@ -58,9 +59,11 @@ class DepthLimitError : public std::runtime_error {
 
 // `bvh` was built over `prims`, which was made from primitives[0, prims.size()) in order.
 // allocators[t] is the handle passed to callbacks running on OpenMP thread t (at least
-// omp_get_max_threads() of them).
+// omp_get_max_threads() of them). With `context`, the emitter's working memory is kept in
+// it for the next call (the RTCBVH's context: rebuilds write into memory already touched).
 EmitResult emit_to_callbacks(const Bvh& bvh, const PrimitiveSet& prims, RTCBuildPrimitive* primitives,
                              const EmitLimits& limits, const EmbreeCallbacks& callbacks,
-                             const std::vector<RTCThreadLocalAllocator>& allocators);
+                             const std::vector<RTCThreadLocalAllocator>& allocators,
+                             BuildContext* context = nullptr);
 
 }  // namespace kmbvh
