@@ -76,6 +76,28 @@ TEST(BuilderApi, ValidTreesForEveryQualityAndBranchingFactor) {
   EXPECT_EQ(rtcGetDeviceError(d.device), RTC_ERROR_NONE);
 }
 
+// Rebuilds on one BVH object write the new tree into the previous tree's blocks and the
+// emitter's kept arrays (plugin/bvh_object.h, the build context): scenes growing and
+// shrinking on one object give the trees a fresh object gives, each one valid.
+TEST(BuilderApi, RebuildsOnOneObjectGiveTheTreesOfFreshObjects) {
+  Device d;
+  RTCBVH reused = kmbvhNewBVH(d.device);
+  for (const uint32_t n : {20000u, 60000u, 5000u, 60000u}) {
+    const std::vector<RTCBuildPrimitive> prims = build_primitives_of(clustered_triangles(n, 21));
+    const Built again = build(kKmbvh, reused, prims, RTC_BUILD_QUALITY_MEDIUM, 4);
+    RTCBVH fresh_bvh = kmbvhNewBVH(d.device);
+    const Built fresh = build(kKmbvh, fresh_bvh, prims, RTC_BUILD_QUALITY_MEDIUM, 4);
+    ASSERT_NE(again.root, nullptr) << n;
+    EXPECT_TRUE(again.report.ok()) << n << ": " << again.report.problem;
+    EXPECT_EQ(again.report.sah_cost, fresh.report.sah_cost) << n;
+    EXPECT_EQ(again.report.leaves, fresh.report.leaves) << n;
+    EXPECT_EQ(again.report.depth, fresh.report.depth) << n;
+    kmbvhReleaseBVH(fresh_bvh);
+  }
+  kmbvhReleaseBVH(reused);
+  EXPECT_TRUE(d.callback_codes.empty());
+}
+
 TEST(BuilderApi, DegenerateInputs) {
   Device d;
   RTCBVH bvh = kmbvhNewBVH(d.device);
