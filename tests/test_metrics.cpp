@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "cuda/core/breadth_first.h"
+#include "cuda/core/refit.h"
 #include "cuda/metrics/sah.h"
 #include "cuda/metrics/tree_stats.h"
 #include "cuda/metrics/validate.h"
@@ -50,6 +51,23 @@ TEST(TreeStats, CountsDepthAndLeaves) {
   EXPECT_EQ(s.max_arity, 2u);
   ASSERT_EQ(s.leaf_size_histogram.size(), 2u);
   EXPECT_EQ(s.leaf_size_histogram[1], 3u);
+}
+
+// Moved primitives: the refitted tree is the hand-made tree of the moved cubes (the cube
+// of leaf 1 swapped with the one of leaf 2 along x, the last cube lifted), and valid.
+TEST(Refit, BoxesFollowMovedPrimitives) {
+  SmallTree t;
+  t.prims.boxes[1] = Aabb(Vec3(6, 0, 0), Vec3(7, 1, 1));
+  t.prims.boxes[2] = Aabb(Vec3(2, 3, 0), Vec3(3, 4, 1));
+  refit_in_place(t.bvh, t.prims);
+  EXPECT_EQ(t.bvh.nodes[0].box, Aabb(Vec3(0, 0, 0), Vec3(7, 4, 1)));
+  EXPECT_EQ(t.bvh.nodes[1].box, t.prims.boxes[0]);
+  EXPECT_EQ(t.bvh.nodes[2].box, Aabb(Vec3(2, 0, 0), Vec3(7, 4, 1)));
+  EXPECT_EQ(t.bvh.nodes[3].box, t.prims.boxes[1]);
+  EXPECT_EQ(t.bvh.nodes[4].box, t.prims.boxes[2]);
+  EXPECT_TRUE(validate(t.bvh, t.prims, {}).ok());
+  EXPECT_EQ(refit_boxes(t.bvh, t.prims), std::vector<Aabb>({t.bvh.nodes[0].box, t.bvh.nodes[1].box, t.bvh.nodes[2].box,
+                                                            t.bvh.nodes[3].box, t.bvh.nodes[4].box}));
 }
 
 TEST(Validate, AcceptsCorrectTree) {

@@ -1,11 +1,15 @@
 #include "scene_accel.h"
 
+#include <fmt/format.h>
+
+#include <algorithm>
 #include <chrono>
 #include <new>
 
 #include "adapters/builder_registry.h"
 #include "adapters/out/cpu_isa.h"
 #include "cuda/metrics/sah.h"
+#include "cuda/core/refit.h"
 #include "plugin/plugin_config.h"
 #include "plugin/real_embree.h"
 #include "ray_recorder.h"
@@ -74,13 +78,18 @@ bool SceneAccel::trace_filtered(const Ray& ray, const RTCRay& app_ray, unsigned 
   return tracer_->trace_one(ray, query, hit, HitFilter{&SceneAccel::offer, &offer_data});
 }
 
-SceneAccel::SceneAccel(const std::vector<EmbreeTriangleMesh>& meshes, std::vector<GeometryFilters> filters,
-                       RTCBuildQuality quality, AccelReport& report, BuildContext* context)
-    : filters_(std::move(filters)) {
+void SceneAccel::set_filters(std::vector<GeometryFilters> filters) {
+  filters_ = std::move(filters);
+  intersect_filters_ = occluded_filters_ = false;
   for (const GeometryFilters& f : filters_) {
     intersect_filters_ |= f.intersect != nullptr;
     occluded_filters_ |= f.occluded != nullptr;
   }
+}
+
+SceneAccel::SceneAccel(const std::vector<EmbreeTriangleMesh>& meshes, std::vector<GeometryFilters> filters,
+                       RTCBuildQuality quality, AccelReport& report, BuildContext* context, bool refittable) {
+  set_filters(std::move(filters));
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   FlattenedMeshes flat = flatten_triangle_meshes(meshes);
@@ -93,14 +102,61 @@ SceneAccel::SceneAccel(const std::vector<EmbreeTriangleMesh>& meshes, std::vecto
   if (!flat.scene.triangles.empty()) {  // else every ray misses
     const PrimitiveSet prims = make_primitive_set(flat.scene);
     BuildInfo info;
-    const Bvh bvh = run_builder(config, prims, &info, context);
+    Bvh bvh = run_builder(config, prims, &info, context);
     report.allocations = info.backend.allocations;
     report.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     report.sah = sah_cost(bvh);
     tracer_ = std::make_unique<Tracer>(bvh, prims, flat.scene, Layout::Bvh8, Backend::Cpu, &flat.ids);
     report.layout_ms = tracer_->layout_ms();
+    if (refittable)
+      refit_base_.reset(new RefitBase{std::move(bvh), flat.scene.triangles, flat.ids, report.sah, report.builder});
   }
   if (plugin_config().ab.on) geometry_ = std::make_unique<AccelGeometry>(std::move(flat));
+}
+
+bool SceneAccel::refit(const std::vector<EmbreeTriangleMesh>& meshes, std::vector<GeometryFilters> filters,
+                       AccelReport& report, std::string& why) {
+  if (!refit_base_) {
+    why = "no tree kept";
+    return false;
+  }
+  using Clock = std::chrono::steady_clock;
+  const auto start = Clock::now();
+  FlattenedMeshes flat = flatten_triangle_meshes(meshes);
+  RefitBase& base = *refit_base_;
+  // The same triangles: the same vertex indices, and the same ones kept (a vertex that
+  // became non-finite drops its triangles, as Embree's commit does).
+  const auto same_id = [](PrimitiveId a, PrimitiveId b) { return a.geom == b.geom && a.prim == b.prim; };
+  if (flat.scene.triangles != base.triangles ||
+      !std::equal(flat.ids.begin(), flat.ids.end(), base.ids.begin(), base.ids.end(), same_id)) {
+    why = "its triangles changed";
+    return false;
+  }
+  const PrimitiveSet prims = make_primitive_set(flat.scene);
+  // In place: what is traced is the layout, made below, and every refit recomputes every
+  // box, so a refit refused here leaves nothing behind that matters.
+  refit_in_place(base.bvh, prims);
+  const double sah = sah_cost(base.bvh);
+  if (!(sah <= kRefitSahLimit * base.built_sah)) {
+    why = fmt::format("a refit's SAH {:.2f} is above {} times the build's {:.2f}", sah, kRefitSahLimit, base.built_sah);
+    return false;
+  }
+  report.builder = "refit of " + base.builder;
+  report.meshes = meshes.size();
+  report.dropped = flat.dropped;
+  report.triangles = flat.scene.triangles.size();
+  report.isa = to_string(traversal_isa());
+  report.refit = true;
+  report.sah = sah;
+  report.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+  auto tracer = std::make_unique<Tracer>(base.bvh, prims, flat.scene, Layout::Bvh8, Backend::Cpu, &flat.ids);
+  report.layout_ms = tracer->layout_ms();
+  std::unique_ptr<AccelGeometry> geometry = geometry_ ? std::make_unique<AccelGeometry>(std::move(flat)) : nullptr;
+  // Nothing throws past here: the scene changes as a whole or not at all.
+  tracer_ = std::move(tracer);
+  geometry_ = std::move(geometry);
+  set_filters(std::move(filters));
+  return true;
 }
 
 AccelGeometry::AccelGeometry(FlattenedMeshes flat) : scene(std::move(flat.scene)), ids(std::move(flat.ids)) {

@@ -20,8 +20,9 @@ namespace kmbvh::plugin {
 struct AccelReport {
   std::string builder;  // the builder's label, "kmeans Q3"
   size_t triangles = 0, meshes = 0, dropped = 0;
-  double build_ms = 0, layout_ms = 0;
+  double build_ms = 0, layout_ms = 0;  // build_ms: the refit's, for a refit
   double sah = 0;
+  bool refit = false;  // the last build's tree refitted to moved vertices (SceneAccel::refit)
   uint64_t allocations = 0;  // backend memory the build allocated (none when the scene's context held enough)
   std::string isa;  // the traversal kernel's instruction set (adapters/out/cpu_isa.h)
 };
@@ -61,9 +62,21 @@ class SceneAccel {
   // filters: by geomID (empty: none). Throws (std::exception) when the meshes cannot be
   // read or the build fails: the caller lets Embree answer for the scene. `context`: the
   // scene's build memory, kept from one commit to the next (may be null).
+  // `refittable`: the scene is dynamic, and the tree is kept for refit().
   SceneAccel(const std::vector<EmbreeTriangleMesh>& meshes, std::vector<GeometryFilters> filters,
-             RTCBuildQuality quality, AccelReport& report, BuildContext* context = nullptr);
+             RTCBuildQuality quality, AccelReport& report, BuildContext* context = nullptr, bool refittable = false);
   ~SceneAccel();
+
+  // A dynamic scene's commit after its vertices moved (rtcUpdateGeometryBuffer), its
+  // triangles the same: the kept tree's boxes are refitted to the new vertices bottom-up and
+  // laid out again, with no build. Returns false, changing nothing that is traced, where it
+  // cannot: no tree kept, triangles added, dropped or re-indexed, or a refitted tree whose SAH
+  // cost is above kRefitSahLimit times the build's (the motion has spoilt it: a rebuild
+  // pays). Not during traces (Embree's rule for a commit). Throws as the constructor does.
+  // `why`: the reason, where it returns false.
+  bool refit(const std::vector<EmbreeTriangleMesh>& meshes, std::vector<GeometryFilters> filters,
+             AccelReport& report, std::string& why);
+  static constexpr double kRefitSahLimit = 1.25;
 
   // Whether some geometry has a filter for this query (most scenes: none, and the
   // traversal runs without offering hits).
@@ -94,8 +107,19 @@ class SceneAccel {
 
  private:
   static bool offer(void* user, const Ray& ray, const Hit& offered);
+  void set_filters(std::vector<GeometryFilters> filters);
+
+  // What a refit starts from: the tree as built, and the triangles and ids it was built over.
+  struct RefitBase {
+    Bvh bvh;
+    std::vector<Triangle> triangles;
+    std::vector<PrimitiveId> ids;
+    double built_sah = 0;
+    std::string builder;
+  };
 
   std::unique_ptr<Tracer> tracer_;  // null: nothing to hit
+  std::unique_ptr<RefitBase> refit_base_;  // dynamic scenes only
   std::unique_ptr<AccelGeometry> geometry_;
   std::vector<GeometryFilters> filters_;
   bool intersect_filters_ = false, occluded_filters_ = false;

@@ -191,11 +191,43 @@ std::vector<uint64_t> scene_signature(const SceneRecord& s) {
   return sig;
 }
 
+// Whether a commit finds the geometries kmbvh's tree was built from (the same ids and
+// records, and no attach, detach or flag change since), only their contents changed: a
+// dynamic scene's refit may then do (SceneAccel::refit).
+bool same_geometries(const std::vector<uint64_t>& now, const std::vector<uint64_t>& built) {
+  if (now.size() != built.size() || now.empty() || now[0] != built[0]) return false;
+  for (size_t i = 1; i + 2 < now.size(); i += 3)
+    if (now[i] != built[i] || now[i + 1] != built[i + 1]) return false;
+  return true;
+}
+
 void real_commit(RTCScene scene, bool join) {
   if (join)
     KMBVH_REAL_EMBREE(rtcJoinCommitScene)(scene);
   else
     KMBVH_REAL_EMBREE(rtcCommitScene)(scene);
+}
+
+// kmbvh's tree for the commit is ready, a new one (`accel`) or, with null, the refitted one
+// in place: kmbvh answers the scene from now on, and Embree's own commit is deferred unless
+// an instance needs the scene built.
+void publish(RTCScene scene, SceneRecord& s, std::unique_ptr<SceneAccel> accel, std::vector<uint64_t> signature,
+             const AccelReport& report, bool embree_too, bool join) {
+  {
+    std::lock_guard<std::mutex> lock(registry().mutex);
+    s.embree_current.store(false, std::memory_order_release);
+    if (accel) {
+      s.accel.store(accel.get(), std::memory_order_release);
+      s.owned = std::move(accel);  // the previous tree goes: no ray is traced during a commit
+    }
+    s.last_fallback.clear();
+    s.built_from = std::move(signature);
+  }
+  if (ab_mode_on()) ab_note_kmbvh_scene(scene, report);
+  if (embree_too) {
+    real_commit(scene, join);
+    s.embree_current.store(true, std::memory_order_release);
+  }
 }
 
 // Embree answers the scene from now on: its commit is made now.
@@ -408,7 +440,7 @@ void commit_or_build(RTCScene scene, bool join) {
   std::vector<RTCScene> instanced;
   std::string reason;
   RTCBuildQuality quality = RTC_BUILD_QUALITY_MEDIUM;
-  bool embree_too = false, unchanged = false;
+  bool embree_too = false, unchanged = false, refittable = false, dynamic = false;
   std::vector<uint64_t> signature;
   {
     Registry& r = registry();
@@ -420,6 +452,8 @@ void commit_or_build(RTCScene scene, bool join) {
       embree_too = s->instanced;
       signature = scene_signature(*s);
       unchanged = s->accel.load(std::memory_order_relaxed) && signature == s->built_from;
+      dynamic = (s->flags & RTC_SCENE_FLAG_DYNAMIC) != 0;
+      refittable = dynamic && s->owned && same_geometries(signature, s->built_from);
     }
   }
   if (!s) return real_commit(scene, join);  // not tracked (the table was full)
@@ -440,10 +474,32 @@ void commit_or_build(RTCScene scene, bool join) {
     return;
   }
 
+  // A dynamic scene whose vertices moved: the tree refitted, where that does (SceneAccel::refit).
+  if (refittable) {
+    AccelReport report;
+    bool refitted = false;
+    std::string why;
+    try {
+      refitted = s->owned->refit(meshes, filters, report, why);
+    } catch (const std::exception& e) {
+      why = e.what();  // a rebuild tries, and reports what fails
+    }
+    if (!refitted && plugin_config().log)
+      log_line(fmt::format("scene {}: built again, not refitted: {}", static_cast<void*>(scene), why));
+    if (refitted) {
+      if (plugin_config().log)
+        log_line(fmt::format("scene {}: {}, {} triangles, refit {:.1f} ms + layout {:.1f} ms, SAH {:.2f}{}",
+                             static_cast<void*>(scene), report.builder, report.triangles, report.build_ms,
+                             report.layout_ms, report.sah,
+                             embree_too ? "; Embree builds it too (instanced)" : "; Embree's build deferred"));
+      return publish(scene, *s, nullptr, std::move(signature), report, embree_too, join);
+    }
+  }
+
   std::unique_ptr<SceneAccel> accel;
   AccelReport report;
   try {
-    accel = std::make_unique<SceneAccel>(meshes, std::move(filters), quality, report, &s->build_context);
+    accel = std::make_unique<SceneAccel>(meshes, std::move(filters), quality, report, &s->build_context, dynamic);
   } catch (const std::exception& e) {
     return commit_by_embree(scene, *s, join, std::string("kmbvh could not build it: ") + e.what(), instanced);
   }
@@ -455,19 +511,7 @@ void commit_or_build(RTCScene scene, bool join) {
                          accel->has_filters(Query::Closest) || accel->has_filters(Query::Any) ? " with filter functions" : "",
                          report.build_ms, report.layout_ms, report.isa, report.sah, report.allocations,
                          embree_too ? "; Embree builds it too (instanced)" : "; Embree's build deferred"));
-  {
-    std::lock_guard<std::mutex> lock(registry().mutex);
-    s->embree_current.store(false, std::memory_order_release);
-    s->accel.store(accel.get(), std::memory_order_release);
-    s->owned = std::move(accel);  // the previous tree goes: no ray is traced during a commit
-    s->last_fallback.clear();
-    s->built_from = std::move(signature);
-  }
-  if (ab_mode_on()) ab_note_kmbvh_scene(scene, report);
-  if (embree_too) {
-    real_commit(scene, join);
-    s->embree_current.store(true, std::memory_order_release);
-  }
+  publish(scene, *s, std::move(accel), std::move(signature), report, embree_too, join);
 }
 
 const SceneAccel* kmbvh_accel(RTCScene scene) {
