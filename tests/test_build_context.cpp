@@ -70,6 +70,7 @@ TEST(BackendCounters, CountTheLevelLoopsSteps) {
     ASSERT_GT(info.levels, 2u) << preset;
     EXPECT_EQ(info.backend.launches, 5 + info.levels * (13 + 4 * params.i)) << preset;
     EXPECT_EQ(info.backend.host_syncs, 7 + info.levels) << preset;
+    EXPECT_EQ(info.level_host_syncs, info.levels) << preset;  // what --json reports per level
   }
 }
 

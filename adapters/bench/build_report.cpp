@@ -24,7 +24,10 @@ nlohmann::json backend_steps_json(const BuildInfo& info) {
                       {"host_syncs", c.host_syncs},
                       {"allocations", c.allocations},
                       {"allocated_bytes", c.allocated_bytes}};
-  if (info.levels > 0) j["host_syncs_per_level"] = double(c.host_syncs) / info.levels;
+  if (info.levels > 0) {
+    j["host_syncs_per_level"] = double(info.level_host_syncs) / info.levels;
+    j["host_syncs_per_build"] = c.host_syncs - info.level_host_syncs;  // the set-up and the finish
+  }
   return j;
 }
 
@@ -124,7 +127,9 @@ std::string measurement_text(const Measurement& m) {
     const BackendCounters& b = m.info.backend;
     line("backend steps", fmt::format("{} launches, {} host syncs{}, {} allocations ({:.1f} MB), last run",
                                       b.launches, b.host_syncs,
-                                      m.info.levels ? fmt::format(" ({:.1f} a level)", double(b.host_syncs) / m.info.levels)
+                                      m.info.levels ? fmt::format(" ({:.1f} a level, {} once)",
+                                                                                  double(m.info.level_host_syncs) / m.info.levels,
+                                                                                  b.host_syncs - m.info.level_host_syncs)
                                                     : "",
                                       b.allocations, b.allocated_bytes / 1048576.0));
   }

@@ -14,6 +14,7 @@ namespace kmbvh {
 struct BuildInfo {
   std::vector<std::pair<std::string, double>> phase_ms;  // in the order the phases first ran
   uint32_t levels = 0;          // top-down levels (k-means)
+  uint64_t level_host_syncs = 0;  // backend.host_syncs made inside those levels (the rest: once a build)
   // Steps taken by position because clustering made no progress: k-means nodes split by
   // index, PLOC iterations that paired Morton neighbours.
   uint32_t forced_splits = 0;

@@ -133,8 +133,9 @@ class KMeansLevels {
 #if KMBVH_CPU_SUBTREES
       if (params_.cpu_subtrees && (segment_count = split_subtrees(segment_count)) == 0) break;
 #endif
-      if (info_) ++info_->levels;
+      const uint64_t syncs = info_ ? info_->backend.host_syncs : 0;
       segment_count = split_level(segment_count);
+      if (info_) ++info_->levels, info_->level_host_syncs += info_->backend.host_syncs - syncs;
       current_ = 1 - current_;
     }
     return finish();
