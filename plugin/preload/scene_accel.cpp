@@ -133,6 +133,10 @@ bool SceneAccel::refit(const std::vector<EmbreeTriangleMesh>& meshes, std::vecto
     return false;
   }
   const PrimitiveSet prims = make_primitive_set(flat.scene);
+  if (prims.size() != base.bvh.prim_indices.size()) {  // flattening keeps finite triangles only: never, but cheap
+    why = "its primitives changed";
+    return false;
+  }
   // In place: what is traced is the layout, made below, and every refit recomputes every
   // box, so a refit refused here leaves nothing behind that matters.
   refit_in_place(base.bvh, prims);
