@@ -100,26 +100,25 @@ struct GatherAhead {
   const TriangleScene& scene;
   static constexpr uint32_t kIds = 6, kTriangles = 4, kPositions = 2;  // leaves ahead
 
+  // f(j) for each primitive j of the leaf (a position in the PrimitiveSet).
   template <typename Each>
   void each(const LeafJob& leaf, Each&& f) const {
     for (uint32_t i = 0; i < leaf.count; ++i) {
       const uint32_t j = bvh.prim_indices[leaf.first + i];
-      if (j < prims.size()) f(prims.ids[j]);
+      if (j < prims.size()) f(j);
     }
   }
   void ids(const LeafJob& leaf) const {
-    for (uint32_t i = 0; i < leaf.count; ++i) {
-      const uint32_t j = bvh.prim_indices[leaf.first + i];
-      if (j < prims.size()) __builtin_prefetch(&prims.ids[j]);
-    }
+    each(leaf, [&](uint32_t j) { __builtin_prefetch(&prims.ids[j]); });
   }
   void triangles(const LeafJob& leaf) const {
-    each(leaf, [&](PrimitiveId id) {
-      if (id.prim < scene.triangles.size()) __builtin_prefetch(&scene.triangles[id.prim]);
+    each(leaf, [&](uint32_t j) {
+      if (prims.ids[j].prim < scene.triangles.size()) __builtin_prefetch(&scene.triangles[prims.ids[j].prim]);
     });
   }
   void positions(const LeafJob& leaf) const {
-    each(leaf, [&](PrimitiveId id) {
+    each(leaf, [&](uint32_t j) {
+      const PrimitiveId id = prims.ids[j];
       if (id.prim >= scene.triangles.size()) return;
       const Triangle& t = scene.triangles[id.prim];
       for (int v = 0; v < 3; ++v) __builtin_prefetch(&scene.positions[t[v]]);

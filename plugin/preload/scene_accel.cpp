@@ -150,7 +150,6 @@ bool SceneAccel::refit(const std::vector<EmbreeTriangleMesh>& meshes, std::vecto
   report.dropped = flat.dropped;
   report.triangles = flat.scene.triangles.size();
   report.isa = to_string(traversal_isa());
-  report.refit = true;
   report.sah = sah;
   report.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
   auto tracer = std::make_unique<Tracer>(base.bvh, prims, flat.scene, Layout::Bvh8, Backend::Cpu, &flat.ids);
