@@ -248,6 +248,14 @@ TEST(Agglomerate, MergeOrderMatchesBruteForce) {
         ASSERT_EQ(fast.right[m], slow.right[m]) << "j=" << j << " seed=" << seed << " merge " << m;
         ASSERT_EQ(fast.box[m], slow.box[m]);
       }
+      if (j > 8) continue;
+      TreeletMerges<8> narrow;  // the width the k = 8 presets build with
+      agglomerate<8>(boxes.data(), weights.data(), j, narrow);
+      for (uint32_t m = 0; m + 1 < j; ++m) {
+        ASSERT_EQ(narrow.left[m], slow.left[m]) << "KMax 8, j=" << j << " seed=" << seed << " merge " << m;
+        ASSERT_EQ(narrow.right[m], slow.right[m]) << "KMax 8, j=" << j << " seed=" << seed << " merge " << m;
+        ASSERT_EQ(narrow.box[m], slow.box[m]);
+      }
     }
   }
 }
