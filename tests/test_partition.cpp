@@ -31,6 +31,13 @@ struct HostLevel {
   ClusterArrays clusters() {
     return {reps.data(), sums.data(), counts.data(), bounds.data(), begin.data(), cluster_segment.data()};
   }
+  // PlaceClusters as the level loop runs it: one exclusive scan over every counter first.
+  void place() {
+    std::vector<uint32_t> scanned(counters.size());
+    std::exclusive_scan(counters.begin(), counters.end(), scanned.begin(), 0u);
+    for (uint32_t p = 0; p < pieces.size(); ++p)
+      PlaceClusters{segments.data(), pieces.data(), scanned.data(), counters.data(), clusters()}(p);
+  }
   LevelView view() {
     return {boxes.data(), ids.data(), cluster_of.data(), segments.data(), pieces.data(), counters.data(), clusters(),
             /*per_node=*/false};
@@ -69,7 +76,8 @@ HostLevel make_level() {
   l.sums.resize(total.clusters);
   l.bounds.assign(total.clusters, OrderedBounds::empty());
   l.reps.resize(total.clusters);
-  for (uint32_t s = 0; s < 2; ++s) SetupSegment{l.segments.data(), l.offsets.data(), sizes, l.pieces.data(), l.cluster_segment.data()}(s);
+  for (uint32_t s = 0; s < 2; ++s) SetupSegment{l.segments.data(), l.offsets.data(), sizes, l.cluster_segment.data()}(s);
+  for (uint32_t p = 0; p < total.pieces; ++p) SetupPiece{l.segments.data(), l.offsets.data(), 2, sizes, l.pieces.data()}(p);
   for (const Segment& s : l.segments)
     for (uint32_t c = 0; c < s.k; ++c) l.reps[s.cluster_base + c] = l.boxes[s.begin + 7 * c];
   l.cluster_of.resize(n);
@@ -84,8 +92,14 @@ TEST(Partition, PiecesCoverSegments) {
   EXPECT_EQ(l.segments[0].piece_count, 1u);
   EXPECT_EQ(l.segments[1].piece_count, 8u);  // ceil(950 / 128)
   uint32_t covered = 0;
-  for (const Piece& p : l.pieces) {
+  for (uint32_t i = 0; i < l.pieces.size(); ++i) {
+    const Piece& p = l.pieces[i];
     const Segment& s = l.segments[p.segment];
+    // Piece q of its segment, in order; its counters cluster-major after the segment's.
+    const uint32_t q = i - s.piece_base;
+    ASSERT_LT(q, s.piece_count);
+    EXPECT_EQ(p.begin, s.begin + 128 * q);
+    EXPECT_EQ(p.counter_base, l.offsets[p.segment].counters + q);
     EXPECT_GE(p.begin, s.begin);
     EXPECT_LE(p.end, s.begin + s.count);
     EXPECT_LE(p.end - p.begin, 128u);
@@ -98,7 +112,7 @@ TEST(Partition, GroupsByClusterStablyAndCountsMatch) {
   HostLevel l = make_level();
   for (uint32_t p = 0; p < l.pieces.size(); ++p) AssignPiece<8, ClusterMetric::Means, AssignPass::Final>{l.view()}(p);
   const std::vector<uint8_t> assigned = l.cluster_of;
-  for (uint32_t s = 0; s < 2; ++s) PlaceClusters{l.segments.data(), l.pieces.data(), l.counters.data(), l.clusters()}(s);
+  l.place();
   for (uint32_t p = 0; p < l.pieces.size(); ++p)
     ScatterPiece<8>{l.boxes.data(), l.ids.data(), l.cluster_of.data(), l.segments.data(), l.pieces.data(),
                     l.counters.data(), l.boxes_out.data(), l.ids_out.data(), l.final_ids.data()}(p);
@@ -172,10 +186,8 @@ TEST(Partition, CountedSizesOfTheNextLevelAreThoseOfTheSegmentsEmitted) {
       HostLevel l = make_level();
       for (uint32_t p = 0; p < l.pieces.size(); ++p)
         AssignPiece<8, ClusterMetric::Means, AssignPass::Final>{l.view()}(p);
-      for (uint32_t s = 0; s < 2; ++s) {
-        PlaceClusters{l.segments.data(), l.pieces.data(), l.counters.data(), l.clusters()}(s);
-        l.segments[s].node = s;
-      }
+      l.place();
+      for (uint32_t s = 0; s < 2; ++s) l.segments[s].node = s;
       NodeRules rules = node_rules(*kmeans_preset(preset));
       rules.max_leaf_size = 20;  // some clusters leaves, some split again
       rules.wide = wide;

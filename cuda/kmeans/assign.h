@@ -147,7 +147,8 @@ struct AssignPiece {
     const bool sole = seg.piece_count == 1;
     if (changed != 0) atomic_add(&level.segments[piece.segment].changed, changed);
     for (uint32_t c = 0; c < k; ++c) {
-      if constexpr (Pass != AssignPass::Sums) level.piece_counters[piece.counter_base + c] = count[c];
+      if constexpr (Pass != AssignPass::Sums)
+        level.piece_counters[piece.counter_base + c * seg.piece_count] = count[c];
       if (count[c] == 0) continue;
       const uint32_t slot = seg.cluster_base + c;
       if (sole)

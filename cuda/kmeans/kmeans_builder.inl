@@ -63,7 +63,7 @@ struct KMeansWorkspace : BuildContext::Workspace {
   Buffer<Segment> segments, next_segments;
   Buffer<SegmentSizes> segment_offsets;
   Buffer<Piece> pieces;
-  Buffer<uint32_t> piece_counters;
+  Buffer<uint32_t> piece_counters, counters_scanned;
   Buffer<Aabb> reps;
   Buffer<ClusterSums> sums;
   Buffer<uint32_t> counts;
@@ -82,7 +82,7 @@ struct KMeansWorkspace : BuildContext::Workspace {
            scratch.bytes_held() + bytes_reserved(boxes[0]) + bytes_reserved(boxes[1]) + bytes_reserved(ids[0]) +
            bytes_reserved(ids[1]) + bytes_reserved(final_ids) + bytes_reserved(cluster_of) +
            bytes_reserved(segments) + bytes_reserved(next_segments) + bytes_reserved(segment_offsets) +
-           bytes_reserved(pieces) + bytes_reserved(piece_counters) + bytes_reserved(reps) + bytes_reserved(sums) +
+           bytes_reserved(pieces) + bytes_reserved(piece_counters) + bytes_reserved(counters_scanned) + bytes_reserved(reps) + bytes_reserved(sums) +
            bytes_reserved(counts) + bytes_reserved(bounds) + bytes_reserved(cluster_begin) +
            bytes_reserved(cluster_segment) + bytes_reserved(child_counts) + bytes_reserved(child_offsets) +
            bytes_reserved(forced) + bytes_reserved(nodes);
@@ -170,7 +170,7 @@ class KMeansLevels {
         clear_clusters(clusters, false);
         for_each_index(piece_count_, AssignPiece<KMax, M, AssignPass::Final>{view()});
         clock_.lap("assign");
-        partition(segment_count, /*gather_only=*/true);
+        partition(/*gather_only=*/true);
         for_each_index(clusters, UpdateMedians{ptr(boxes_[1 - current_]), ptr(segments_), this->clusters()});
         clock_.lap("update");
       }
@@ -185,7 +185,7 @@ class KMeansLevels {
     // host need not wait for the count.
     for_each_index(segment_count, DetectSingleCluster{ptr(segments_), this->clusters(), ptr(forced_)});
     for_each_index(piece_count_, AssignPiece<KMax, M, AssignPass::SplitByIndex>{view()});
-    partition(segment_count, /*gather_only=*/false);
+    partition(/*gather_only=*/false);
     return emit(segment_count);
   }
 
@@ -201,15 +201,17 @@ class KMeansLevels {
     const SegmentSizes total = sizes_;
     piece_count_ = total.pieces;
     grow_to(pieces_, total.pieces);
+    counter_count_ = total.counters;
     grow_to(piece_counters_, total.counters);
+    grow_to(counters_scanned_, total.counters);
     grow_to(reps_, total.clusters);
     grow_to(sums_, total.clusters);
     grow_to(counts_, total.clusters);
     grow_to(bounds_, total.clusters);
     grow_to(cluster_begin_, total.clusters);
     grow_to(cluster_segment_, total.clusters);
-    for_each_index(segment_count, SetupSegment{ptr(segments_), ptr(segment_offsets_), sizes, ptr(pieces_),
-                                               ptr(cluster_segment_)});
+    for_each_index(segment_count, SetupSegment{ptr(segments_), ptr(segment_offsets_), sizes, ptr(cluster_segment_)});
+    for_each_index(piece_count_, SetupPiece{ptr(segments_), ptr(segment_offsets_), segment_count, sizes, ptr(pieces_)});
     clock_.lap("setup");
     return total.clusters;
   }
@@ -232,8 +234,11 @@ class KMeansLevels {
 
   // Counting sort of every segment by cluster into the other buffer. A median update
   // only gathers the boxes; the level's last partition moves ids and output order too.
-  void partition(uint32_t segment_count, bool gather_only) {
-    for_each_index(segment_count, PlaceClusters{ptr(segments_), ptr(pieces_), ptr(piece_counters_), clusters()});
+  void partition(bool gather_only) {
+    thrust::exclusive_scan(launch(), piece_counters_.begin(), piece_counters_.begin() + counter_count_,
+                           counters_scanned_.begin());
+    for_each_index(piece_count_, PlaceClusters{ptr(segments_), ptr(pieces_), ptr(counters_scanned_),
+                                               ptr(piece_counters_), clusters()});
     const int to = 1 - current_;
     for_each_index(piece_count_,
                    ScatterPiece<KMax>{ptr(boxes_[current_]), ptr(ids_[current_]), ptr(cluster_of_),
@@ -348,7 +353,7 @@ class KMeansLevels {
   Bvh finish() {
     if (!keep_)
       release(boxes_[0], boxes_[1], ids_[0], ids_[1], cluster_of_, segments_, next_segments_, segment_offsets_,
-              pieces_, piece_counters_, reps_, sums_, counts_, bounds_, cluster_begin_, cluster_segment_,
+              pieces_, piece_counters_, counters_scanned_, reps_, sums_, counts_, bounds_, cluster_begin_, cluster_segment_,
               child_counts_, child_offsets_);
     size_t total = node_count_;
 #if KMBVH_CPU_SUBTREES
@@ -394,6 +399,8 @@ class KMeansLevels {
   Buffer<Piece>& pieces_ = ws_.pieces;
   uint32_t piece_count_ = 0;
   Buffer<uint32_t>& piece_counters_ = ws_.piece_counters;
+  Buffer<uint32_t>& counters_scanned_ = ws_.counters_scanned;
+  uint32_t counter_count_ = 0;
 
   Buffer<Aabb>& reps_ = ws_.reps;
   Buffer<ClusterSums>& sums_ = ws_.sums;

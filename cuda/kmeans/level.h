@@ -31,7 +31,10 @@ struct Segment {
 struct Piece {
   uint32_t segment = 0;
   uint32_t begin = 0, end = 0;   // primitive range inside the segment's
-  uint32_t counter_base = 0;     // its k per-cluster counters (counts, then scatter cursors)
+  // Its first per-cluster counter (counts, then scatter cursors). A segment's counters are
+  // cluster-major: cluster c of piece q is at the segment's first + c * piece_count + q, so
+  // one scan over all counters is the partition's counting-sort order (partition.h).
+  uint32_t counter_base = 0;
 };
 
 // Fixed-point sums of a cluster's min and max corners (see update_means.h).

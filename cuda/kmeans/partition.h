@@ -34,25 +34,30 @@ struct DetectSingleCluster {
   }
 };
 
-// Per segment: cluster c starts after clusters 0..c-1; within it, piece q writes after
-// pieces 0..q-1. Overwrites the per-piece counts with those starting positions.
+// Per segment, cluster c starts after clusters 0..c-1, and within it piece q writes after
+// pieces 0..q-1: the order the counters are stored in (level.h, Piece::counter_base), so one
+// exclusive scan over all of them (`scanned`) holds every cursor, less what the segment's
+// first counter holds. One thread per piece turns its counts into those cursors (the piece
+// of a segment's first piece also gives its clusters' first primitives): no thread walks a
+// segment's k x pieces counters in turn, which at the root of a large scene on the GPU were
+// tens of thousands of dependent steps (issue #17).
 struct PlaceClusters {
   const Segment* segments;
   const Piece* pieces;
-  uint32_t* piece_counters;
+  const uint32_t* scanned;   // exclusive scan of piece_counters' counts
+  uint32_t* piece_counters;  // counts in, cursors out
   ClusterArrays clusters;
 
-  KMBVH_HD void operator()(uint32_t s) const {
-    const Segment seg = segments[s];
-    uint32_t cursor = seg.begin;
+  KMBVH_HD void operator()(uint32_t p) const {
+    const Piece piece = pieces[p];
+    const Segment seg = segments[piece.segment];
+    const uint32_t q = p - seg.piece_base;
+    const uint32_t first = scanned[piece.counter_base - q];  // the segment's first counter's
     for (uint32_t c = 0; c < seg.k; ++c) {
-      clusters.begin[seg.cluster_base + c] = cursor;
-      for (uint32_t q = 0; q < seg.piece_count; ++q) {
-        uint32_t& counter = piece_counters[pieces[seg.piece_base + q].counter_base + c];
-        const uint32_t n = counter;
-        counter = cursor;
-        cursor += n;
-      }
+      const uint32_t at = piece.counter_base + c * seg.piece_count;
+      const uint32_t cursor = seg.begin + (scanned[at] - first);
+      piece_counters[at] = cursor;
+      if (q == 0) clusters.begin[seg.cluster_base + c] = cursor;
     }
   }
 };
@@ -74,9 +79,10 @@ struct ScatterPiece {
 
   KMBVH_HD void operator()(uint32_t piece_index) const {
     const Piece piece = pieces[piece_index];
-    const uint32_t k = segments[piece.segment].k;
+    const Segment& seg = segments[piece.segment];
+    const uint32_t k = seg.k;
     uint32_t cursor[KMax];
-    for (uint32_t c = 0; c < k; ++c) cursor[c] = piece_counters[piece.counter_base + c];
+    for (uint32_t c = 0; c < k; ++c) cursor[c] = piece_counters[piece.counter_base + c * seg.piece_count];
     for (uint32_t i = piece.begin; i < piece.end; ++i) {
       const uint32_t to = cursor[cluster_of[i]]++;
       boxes_out[to] = boxes_in[i];

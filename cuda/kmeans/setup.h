@@ -37,7 +37,6 @@ struct SetupSegment {
   Segment* segments;
   const SegmentSizes* offsets;  // exclusive scan of SizesOfSegment
   SizesOfSegment sizes;
-  Piece* pieces;
   uint32_t* cluster_segment;
 
   KMBVH_HD void operator()(uint32_t s) const {
@@ -49,15 +48,37 @@ struct SetupSegment {
     seg.split_by_index = 0;
     seg.changed = 0;
     seg.stable = 0;
-    for (uint32_t q = 0; q < seg.piece_count; ++q) {
-      Piece& piece = pieces[seg.piece_base + q];
-      piece.segment = s;
-      piece.begin = seg.begin + q * sizes.piece_size;
-      const uint32_t end = piece.begin + sizes.piece_size;
-      piece.end = end < seg.begin + seg.count ? end : seg.begin + seg.count;
-      piece.counter_base = at.counters + q * seg.k;
-    }
     for (uint32_t c = 0; c < seg.k; ++c) cluster_segment[seg.cluster_base + c] = s;
+  }
+};
+
+// One thread per piece, not a loop over its segment's pieces (the root of a large scene
+// has thousands on the GPU, issue #17): the piece's segment is the last whose first piece
+// is not after it, found by a binary search of the offsets' scan.
+struct SetupPiece {
+  const Segment* segments;      // after SetupSegment
+  const SegmentSizes* offsets;  // as SetupSegment's (entries 0 .. segment_count - 1 are read)
+  uint32_t segment_count;
+  SizesOfSegment sizes;
+  Piece* pieces;
+
+  KMBVH_HD void operator()(uint32_t p) const {
+    uint32_t lo = 0, hi = segment_count;  // offsets[lo].pieces <= p < offsets[hi].pieces
+    while (hi - lo > 1) {
+      const uint32_t mid = lo + (hi - lo) / 2;
+      if (offsets[mid].pieces <= p)
+        lo = mid;
+      else
+        hi = mid;
+    }
+    const Segment& seg = segments[lo];
+    const uint32_t q = p - seg.piece_base;
+    Piece& piece = pieces[p];
+    piece.segment = lo;
+    piece.begin = seg.begin + q * sizes.piece_size;
+    const uint32_t end = piece.begin + sizes.piece_size;
+    piece.end = end < seg.begin + seg.count ? end : seg.begin + seg.count;
+    piece.counter_base = offsets[lo].counters + q;  // cluster c: + c * seg.piece_count
   }
 };
 
