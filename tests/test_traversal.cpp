@@ -439,6 +439,41 @@ TEST(Traversal, OnePassLayoutIsTheReferenceByteForByte) {
                                              "one leaf");
 }
 
+// A layout made in an earlier layout's memory (a scene committed again) is the layout made
+// fresh, byte for byte, whether the earlier one was larger or smaller; it takes that
+// memory over, and leaves the earlier one empty (its tracer answers misses).
+TEST(Traversal, LayoutInAnEarlierLayoutsMemoryIsTheFreshLayout) {
+  const TriangleScene big = test::random_triangles(6000, 40), small = test::random_triangles(2000, 41);
+  const PrimitiveSet big_prims = make_primitive_set(big), small_prims = make_primitive_set(small);
+  const Bvh big_tree = run_builder(parse_builder("Q2"), big_prims);
+  const Bvh small_tree = run_builder(parse_builder("lbvh"), small_prims);
+  WideBvh<8> earlier = lay_out_wide<8>(big_tree, big_prims, big, true);
+  const TrianglePack* memory = earlier.packs.data();
+  // Smaller than the memory it gets: no new allocation.
+  WideBvh<8> again = lay_out_wide<8>(small_tree, small_prims, small, true, nullptr, &earlier);
+  expect_same_layout(again, lay_out_wide<8>(small_tree, small_prims, small, true), "in a larger layout's memory");
+  EXPECT_EQ(again.packs.data(), memory);
+  EXPECT_TRUE(earlier.nodes.empty() && earlier.packs.empty());
+  // Larger: the arrays grow, and the layout is still the fresh one.
+  WideBvh<8> grown = lay_out_wide<8>(big_tree, big_prims, big, true, nullptr, &again);
+  expect_same_layout(grown, lay_out_wide<8>(big_tree, big_prims, big, true), "in a smaller layout's memory");
+
+  // Through Tracer: the tracer whose memory was taken answers misses, the new one hits.
+  Tracer first(big_tree, big_prims, big, Layout::Bvh8);
+  const Tracer second(small_tree, small_prims, small, Layout::Bvh8, Backend::Cpu, nullptr, &first);
+  Ray ray;
+  ray.org = small_prims.boxes[0].center() - Vec3(0, 0, 10);
+  ray.dir = Vec3(0, 0, 1);
+  ray.tfar = INFINITY;
+  Hit a, b;
+  EXPECT_FALSE(first.trace_one(ray, Query::Closest, a));
+  const Tracer fresh(small_tree, small_prims, small, Layout::Bvh8);
+  ASSERT_TRUE(fresh.trace_one(ray, Query::Closest, a));  // through a triangle soup's middle
+  EXPECT_TRUE(second.trace_one(ray, Query::Closest, b));
+  EXPECT_EQ(a.primID, b.primID);
+  EXPECT_EQ(a.t, b.t);
+}
+
 TEST(Traversal, OnePassLayoutRefusesWhatDoesNotFit) {
   const TriangleScene scene = test::random_triangles(1000, 38);
   const PrimitiveSet prims = make_primitive_set(scene);

@@ -35,7 +35,7 @@ Bvh traced_tree(const Bvh& bvh, Layout layout) {
 }
 
 Tracer::Tracer(const Bvh& bvh, const PrimitiveSet& prims, const TriangleScene& scene, Layout layout, Backend backend,
-               const std::vector<PrimitiveId>* reported_ids)
+               const std::vector<PrimitiveId>* reported_ids, Tracer* reuse)
     : layout_(layout), backend_(backend), layouts_(std::make_unique<Layouts>()) {
   if (backend == Backend::Cuda && layout != Layout::Bvh2)
     throw std::invalid_argument("the CUDA traversal reads the bvh2 layout; bvh4 and bvh8 are CPU SIMD layouts");
@@ -52,8 +52,12 @@ Tracer::Tracer(const Bvh& bvh, const PrimitiveSet& prims, const TriangleScene& s
       layouts_->bvh2 = make_bvh2(bvh, leaf_triangles(bvh, prims, scene, reported_ids));
       if (backend == Backend::Cuda) layouts_->bvh2_gpu = std::make_unique<Bvh2OnGpu>(layouts_->bvh2);
       break;
-    case Layout::Bvh4: layouts_->bvh4 = lay_out_wide<4>(bvh, prims, scene, collapsed_, reported_ids); break;
-    case Layout::Bvh8: layouts_->bvh8 = lay_out_wide<8>(bvh, prims, scene, collapsed_, reported_ids); break;
+    case Layout::Bvh4:
+      layouts_->bvh4 = lay_out_wide<4>(bvh, prims, scene, collapsed_, reported_ids, reuse ? &reuse->layouts_->bvh4 : nullptr);
+      break;
+    case Layout::Bvh8:
+      layouts_->bvh8 = lay_out_wide<8>(bvh, prims, scene, collapsed_, reported_ids, reuse ? &reuse->layouts_->bvh8 : nullptr);
+      break;
   }
   layout_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }

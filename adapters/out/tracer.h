@@ -33,9 +33,12 @@ class Tracer {
   // not exceed the layout's width. Throws std::invalid_argument when it cannot be laid out.
   // reported_ids, when given, is what a hit reports for each triangle of `scene` (indexed
   // by the triangle's position, as prims' ids are): Embree's geomID/primID pairs of a
-  // scene flattened from several meshes.
+  // scene flattened from several meshes. reuse, when given, is a tracer that will not trace
+  // again (a scene's previous tree, at a commit): this one lays its layout out in that one's
+  // memory (wide_layout.h), which leaves `reuse` answering every ray with a miss.
   Tracer(const Bvh& bvh, const PrimitiveSet& prims, const TriangleScene& scene, Layout layout,
-         Backend backend = Backend::Cpu, const std::vector<PrimitiveId>* reported_ids = nullptr);
+         Backend backend = Backend::Cpu, const std::vector<PrimitiveId>* reported_ids = nullptr,
+         Tracer* reuse = nullptr);
   ~Tracer();
   Tracer(Tracer&&) noexcept;
 

@@ -49,8 +49,10 @@ void plan_lane(Plan<W>& plan, WideNode<W>& node, int lane, const Bvh& bvh, uint3
 
 // Depth first, first child first, as lay_out_depth_first walks the collapsed tree.
 template <int W>
-Plan<W> plan_layout(const Bvh& bvh, bool collapse) {
+Plan<W> plan_layout(const Bvh& bvh, bool collapse, LayoutArray<WideNode<W>> nodes) {
   Plan<W> plan;
+  plan.out.nodes = std::move(nodes);
+  plan.out.nodes.clear();  // keeps its memory
   plan.out.nodes.reserve(bvh.nodes.size() / (collapse ? W - 1 : 1) + 1);
   plan.leaves.reserve(bvh.nodes.size() / 2 + 1);
   if (bvh.root().is_leaf()) {  // one leaf: a root with a single lane
@@ -179,7 +181,7 @@ void touch_pages(void* p, size_t bytes, int t, int n) {
 
 template <int W>
 WideBvh<W> lay_out_wide(const Bvh& bvh, const PrimitiveSet& prims, const TriangleScene& scene, bool collapse,
-                        const std::vector<PrimitiveId>* reported_ids) {
+                        const std::vector<PrimitiveId>* reported_ids, WideBvh<W>* reuse) {
   if (reported_ids && reported_ids->size() != scene.triangles.size())
     throw std::invalid_argument("lay_out_wide: reported_ids needs one id per triangle of the scene");
   if (bvh.empty() || (bvh.root().is_leaf() && bvh.root().count == 0)) return WideBvh<W>();
@@ -187,14 +189,22 @@ WideBvh<W> lay_out_wide(const Bvh& bvh, const PrimitiveSet& prims, const Triangl
   // touches of the packs' pages (conference's 18 MB: 5.3 ms of faults and zeroing on this
   // project's machines, even on huge pages), which the fill would otherwise wait for.
   LayoutArray<TrianglePack> packs;
+  LayoutArray<WideNode<W>> nodes;
+  if (reuse) {
+    packs = std::move(reuse->packs);
+    nodes = std::move(reuse->nodes);
+    *reuse = WideBvh<W>();
+    packs.clear();
+  }
+  const size_t touched = packs.capacity();  // pages a previous layout wrote: no fault to take
   packs.resize(count_packs(bvh));  // not zeroed (layout_memory.h): fill_leaf writes each pack whole
   Plan<W> plan;
   ParallelErrors errors;
 #pragma omp parallel
   {
     if (omp_get_thread_num() == 0)
-      errors.capture([&] { plan = plan_layout<W>(bvh, collapse); });
-    else
+      errors.capture([&] { plan = plan_layout<W>(bvh, collapse, std::move(nodes)); });
+    else if (packs.size() > touched)
       touch_pages(packs.data(), packs.size() * sizeof(TrianglePack), omp_get_thread_num() - 1,
                   omp_get_num_threads() - 1);
   }
@@ -226,8 +236,8 @@ WideBvh<W> lay_out_wide(const Bvh& bvh, const PrimitiveSet& prims, const Triangl
 }
 
 template WideBvh<4> lay_out_wide<4>(const Bvh&, const PrimitiveSet&, const TriangleScene&, bool,
-                                    const std::vector<PrimitiveId>*);
+                                    const std::vector<PrimitiveId>*, WideBvh<4>*);
 template WideBvh<8> lay_out_wide<8>(const Bvh&, const PrimitiveSet&, const TriangleScene&, bool,
-                                    const std::vector<PrimitiveId>*);
+                                    const std::vector<PrimitiveId>*, WideBvh<8>*);
 
 }  // namespace kmbvh

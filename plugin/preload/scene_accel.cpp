@@ -88,7 +88,8 @@ void SceneAccel::set_filters(std::vector<GeometryFilters> filters) {
 }
 
 SceneAccel::SceneAccel(const std::vector<EmbreeTriangleMesh>& meshes, std::vector<GeometryFilters> filters,
-                       RTCBuildQuality quality, AccelReport& report, BuildContext* context, bool refittable) {
+                       RTCBuildQuality quality, AccelReport& report, BuildContext* context, bool refittable,
+                       SceneAccel* previous) {
   set_filters(std::move(filters));
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
@@ -106,7 +107,8 @@ SceneAccel::SceneAccel(const std::vector<EmbreeTriangleMesh>& meshes, std::vecto
     report.allocations = info.backend.allocations;
     report.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     report.sah = sah_cost(bvh);
-    tracer_ = std::make_unique<Tracer>(bvh, prims, flat.scene, Layout::Bvh8, Backend::Cpu, &flat.ids);
+    tracer_ = std::make_unique<Tracer>(bvh, prims, flat.scene, Layout::Bvh8, Backend::Cpu, &flat.ids,
+                                       previous ? previous->tracer_.get() : nullptr);
     report.layout_ms = tracer_->layout_ms();
     if (refittable)
       refit_base_.reset(new RefitBase{std::move(bvh), flat.scene.triangles, flat.ids, report.sah, report.builder});
@@ -152,10 +154,12 @@ bool SceneAccel::refit(const std::vector<EmbreeTriangleMesh>& meshes, std::vecto
   report.isa = to_string(traversal_isa());
   report.sah = sah;
   report.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-  auto tracer = std::make_unique<Tracer>(base.bvh, prims, flat.scene, Layout::Bvh8, Backend::Cpu, &flat.ids);
+  auto tracer = std::make_unique<Tracer>(base.bvh, prims, flat.scene, Layout::Bvh8, Backend::Cpu, &flat.ids,
+                                         tracer_.get());
   report.layout_ms = tracer->layout_ms();
   std::unique_ptr<AccelGeometry> geometry = geometry_ ? std::make_unique<AccelGeometry>(std::move(flat)) : nullptr;
-  // Nothing throws past here: the scene changes as a whole or not at all.
+  // Nothing throws past here. (The new layout has the old one's memory already: a throw
+  // above leaves this tree answering misses until the caller builds the scene again.)
   tracer_ = std::move(tracer);
   geometry_ = std::move(geometry);
   set_filters(std::move(filters));

@@ -61,9 +61,13 @@ class SceneAccel {
   // filters: by geomID (empty: none). Throws (std::exception) when the meshes cannot be
   // read or the build fails: the caller lets Embree answer for the scene. `context`: the
   // scene's build memory, kept from one commit to the next (may be null).
-  // `refittable`: the scene is dynamic, and the tree is kept for refit().
+  // `refittable`: the scene is dynamic, and the tree is kept for refit(). `previous`: the
+  // scene's tree until this commit, never traced again (Embree's rule: no trace during a
+  // commit), whose layout memory the new layout takes over (Tracer's reuse), so a scene
+  // committed again and again does not fault in fresh pages for every layout.
   SceneAccel(const std::vector<EmbreeTriangleMesh>& meshes, std::vector<GeometryFilters> filters,
-             RTCBuildQuality quality, AccelReport& report, BuildContext* context = nullptr, bool refittable = false);
+             RTCBuildQuality quality, AccelReport& report, BuildContext* context = nullptr, bool refittable = false,
+             SceneAccel* previous = nullptr);
   ~SceneAccel();
 
   // A dynamic scene's commit after its vertices moved (rtcUpdateGeometryBuffer), its
@@ -71,7 +75,9 @@ class SceneAccel {
   // laid out again, with no build. Returns false, changing nothing that is traced, where it
   // cannot: no tree kept, triangles added, dropped or re-indexed, or a refitted tree whose SAH
   // cost is above kRefitSahLimit times the build's (the motion has spoilt it: a rebuild
-  // pays). Not during traces (Embree's rule for a commit). Throws as the constructor does.
+  // pays). Not during traces (Embree's rule for a commit). Throws as the constructor does;
+  // the new layout is made in the old one's memory, so after a throw this tree answers every
+  // ray with a miss until the caller builds the scene again.
   // `why`: the reason, where it returns false.
   bool refit(const std::vector<EmbreeTriangleMesh>& meshes, std::vector<GeometryFilters> filters,
              AccelReport& report, std::string& why);

@@ -499,7 +499,8 @@ void commit_or_build(RTCScene scene, bool join) {
   std::unique_ptr<SceneAccel> accel;
   AccelReport report;
   try {
-    accel = std::make_unique<SceneAccel>(meshes, std::move(filters), quality, report, &s->build_context, dynamic);
+    accel = std::make_unique<SceneAccel>(meshes, std::move(filters), quality, report, &s->build_context, dynamic,
+                                         s->owned.get());
   } catch (const std::exception& e) {
     return commit_by_embree(scene, *s, join, std::string("kmbvh could not build it: ") + e.what(), instanced);
   }
