@@ -53,7 +53,7 @@ Plan<W> plan_layout(const Bvh& bvh, bool collapse, LayoutArray<WideNode<W>> node
   Plan<W> plan;
   plan.out.nodes = std::move(nodes);
   plan.out.nodes.clear();  // keeps its memory
-  plan.out.nodes.reserve(bvh.nodes.size() / (collapse ? W - 1 : 1) + 1);
+  plan.out.nodes.reserve(bvh.nodes.size() / 2 + 1);  // a wide node per interior node at most: never grown
   plan.leaves.reserve(bvh.nodes.size() / 2 + 1);
   if (bvh.root().is_leaf()) {  // one leaf: a root with a single lane
     plan.out.nodes.push_back(empty_wide_node<W>());
