@@ -76,8 +76,10 @@ HostLevel make_level() {
   l.sums.resize(total.clusters);
   l.bounds.assign(total.clusters, OrderedBounds::empty());
   l.reps.resize(total.clusters);
-  for (uint32_t s = 0; s < 2; ++s) SetupSegment{l.segments.data(), l.offsets.data(), sizes, l.cluster_segment.data()}(s);
-  for (uint32_t p = 0; p < total.pieces; ++p) SetupPiece{l.segments.data(), l.offsets.data(), 2, sizes, l.pieces.data()}(p);
+  for (uint32_t s = 0; s < 2; ++s)
+    SetupSegment{l.segments.data(), l.offsets.data(), sizes, l.cluster_segment.data()}(s);
+  for (uint32_t p = 0; p < total.pieces; ++p)
+    SetupPiece{l.segments.data(), l.offsets.data(), 2, sizes, l.pieces.data()}(p);
   for (const Segment& s : l.segments)
     for (uint32_t c = 0; c < s.k; ++c) l.reps[s.cluster_base + c] = l.boxes[s.begin + 7 * c];
   l.cluster_of.resize(n);

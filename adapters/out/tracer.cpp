@@ -53,10 +53,12 @@ Tracer::Tracer(const Bvh& bvh, const PrimitiveSet& prims, const TriangleScene& s
       if (backend == Backend::Cuda) layouts_->bvh2_gpu = std::make_unique<Bvh2OnGpu>(layouts_->bvh2);
       break;
     case Layout::Bvh4:
-      layouts_->bvh4 = lay_out_wide<4>(bvh, prims, scene, collapsed_, reported_ids, reuse ? &reuse->layouts_->bvh4 : nullptr);
+      layouts_->bvh4 =
+          lay_out_wide<4>(bvh, prims, scene, collapsed_, reported_ids, reuse ? &reuse->layouts_->bvh4 : nullptr);
       break;
     case Layout::Bvh8:
-      layouts_->bvh8 = lay_out_wide<8>(bvh, prims, scene, collapsed_, reported_ids, reuse ? &reuse->layouts_->bvh8 : nullptr);
+      layouts_->bvh8 =
+          lay_out_wide<8>(bvh, prims, scene, collapsed_, reported_ids, reuse ? &reuse->layouts_->bvh8 : nullptr);
       break;
   }
   layout_ms_ = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();

@@ -82,8 +82,8 @@ struct KMeansWorkspace : BuildContext::Workspace {
            scratch.bytes_held() + bytes_reserved(boxes[0]) + bytes_reserved(boxes[1]) + bytes_reserved(ids[0]) +
            bytes_reserved(ids[1]) + bytes_reserved(final_ids) + bytes_reserved(cluster_of) +
            bytes_reserved(segments) + bytes_reserved(next_segments) + bytes_reserved(segment_offsets) +
-           bytes_reserved(pieces) + bytes_reserved(piece_counters) + bytes_reserved(counters_scanned) + bytes_reserved(reps) + bytes_reserved(sums) +
-           bytes_reserved(counts) + bytes_reserved(bounds) + bytes_reserved(cluster_begin) +
+           bytes_reserved(pieces) + bytes_reserved(piece_counters) + bytes_reserved(counters_scanned) +
+           bytes_reserved(reps) + bytes_reserved(sums) + bytes_reserved(counts) + bytes_reserved(bounds) + bytes_reserved(cluster_begin) +
            bytes_reserved(cluster_segment) + bytes_reserved(child_counts) + bytes_reserved(child_offsets) +
            bytes_reserved(forced) + bytes_reserved(nodes);
   }
@@ -353,8 +353,8 @@ class KMeansLevels {
   Bvh finish() {
     if (!keep_)
       release(boxes_[0], boxes_[1], ids_[0], ids_[1], cluster_of_, segments_, next_segments_, segment_offsets_,
-              pieces_, piece_counters_, counters_scanned_, reps_, sums_, counts_, bounds_, cluster_begin_, cluster_segment_,
-              child_counts_, child_offsets_);
+              pieces_, piece_counters_, counters_scanned_, reps_, sums_, counts_, bounds_, cluster_begin_,
+              cluster_segment_, child_counts_, child_offsets_);
     size_t total = node_count_;
 #if KMBVH_CPU_SUBTREES
     std::vector<uint32_t> offset;

@@ -175,7 +175,8 @@ class Builder {
 }  // namespace
 
 Bvh build_kmeans_reference(const PrimitiveSet& prims, const ReferenceKMeans& params) {
-  if (prims.size() <= params.max_leaf_size) return Bvh::single_leaf(prims.bounds(), static_cast<uint32_t>(prims.size()));
+  if (prims.size() <= params.max_leaf_size)
+    return Bvh::single_leaf(prims.bounds(), static_cast<uint32_t>(prims.size()));
   return Builder(prims, params).build();
 }
 
