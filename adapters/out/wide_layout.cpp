@@ -8,6 +8,7 @@
 #include <string>
 
 #include "collapse_wide.h"
+#include "cuda/core/huge_pages.h"
 #include "cuda/core/parallel_errors.h"
 #include "cuda/traversal/watertight.h"
 
@@ -168,13 +169,13 @@ uint32_t count_packs(const Bvh& bvh) {
   return uint32_t(packs);
 }
 
-// Touches every page of `bytes` at `p` once (a write of its first byte), on the calling
-// thread's share of them (thread `t` of `n`): the fault, and the kernel's zeroing of the
-// page, then happen here and not in the fill.
-void touch_pages(void* p, size_t bytes, int t, int n) {
-  constexpr size_t kPage = 4096;
-  char* base = static_cast<char*>(p);
-  for (size_t at = size_t(t) * kPage; at < bytes; at += size_t(n) * kPage) base[at] = 0;
+// Faults in thread `t`'s share (of `n`) of the pages of `bytes` at `p` (huge_pages.h:
+// populate_pages): the kernel's allocation and zeroing of the pages then happen here and
+// not in the fill.
+void populate_share(void* p, size_t bytes, int t, int n) {
+  const size_t share = (bytes + size_t(n) - 1) / size_t(n);
+  const size_t begin = std::min(bytes, share * size_t(t)), end = std::min(bytes, begin + share);
+  populate_pages(static_cast<char*>(p) + begin, end - begin);
 }
 
 }  // namespace
@@ -205,8 +206,8 @@ WideBvh<W> lay_out_wide(const Bvh& bvh, const PrimitiveSet& prims, const Triangl
     if (omp_get_thread_num() == 0)
       errors.capture([&] { plan = plan_layout<W>(bvh, collapse, std::move(nodes)); });
     else if (packs.size() > touched)
-      touch_pages(packs.data(), packs.size() * sizeof(TrianglePack), omp_get_thread_num() - 1,
-                  omp_get_num_threads() - 1);
+      populate_share(packs.data(), packs.size() * sizeof(TrianglePack), omp_get_thread_num() - 1,
+                     omp_get_num_threads() - 1);
   }
   errors.rethrow();
   WideBvh<W>& out = plan.out;

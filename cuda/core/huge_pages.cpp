@@ -18,4 +18,13 @@ void advise_huge_pages([[maybe_unused]] const void* p, [[maybe_unused]] size_t b
 #endif
 }
 
+void populate_pages([[maybe_unused]] const void* p, [[maybe_unused]] size_t bytes) {
+#if defined(__linux__) && defined(MADV_POPULATE_WRITE)
+  constexpr uintptr_t kPage = 4096;
+  const uintptr_t begin = (reinterpret_cast<uintptr_t>(p) + kPage - 1) & ~(kPage - 1);
+  const uintptr_t end = (reinterpret_cast<uintptr_t>(p) + bytes) & ~(kPage - 1);
+  if (end > begin) madvise(reinterpret_cast<void*>(begin), end - begin, MADV_POPULATE_WRITE);  // errors: faults as before
+#endif
+}
+
 }  // namespace kmbvh

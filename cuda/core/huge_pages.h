@@ -16,12 +16,22 @@ namespace kmbvh {
 // all but its ends).
 void advise_huge_pages(const void* p, size_t bytes);
 
-// v.reserve(n), with the new storage advised before anything is written to it.
+// Faults in the whole 4 KiB pages inside [p, p + bytes) for writing, in one system call
+// (MADV_POPULATE_WRITE, Linux 5.14): the kernel allocates and zeroes them as the first
+// writes would, without a fault for each. On this project's virtual machines a fault costs
+// about 16 us, most of it the trap, so a 1 MiB array under the 2 MiB of a huge page costs
+// 7 ms written fresh and about 1 ms populated first. For memory that is about to be written
+// whole; where the kernel cannot, the pages fault as before.
+void populate_pages(const void* p, size_t bytes);
+
+// v.reserve(n), with the new storage advised, and populated, before anything is written to
+// it: for arrays that are then written up to n.
 template <typename T>
 void reserve_on_huge_pages(std::vector<T>& v, size_t n) {
   if (n <= v.capacity()) return;
   v.reserve(n);
   advise_huge_pages(v.data() + v.size(), (v.capacity() - v.size()) * sizeof(T));
+  populate_pages(v.data() + v.size(), (n - v.size()) * sizeof(T));
 }
 
 }  // namespace kmbvh

@@ -2,6 +2,8 @@
 
 #include <vector>
 
+#include "huge_pages.h"
+
 namespace kmbvh {
 namespace {
 
@@ -20,9 +22,16 @@ void gather(const Bvh& bvh, uint32_t node, std::vector<uint32_t>& out) {
 Bvh collapse_leaves_by_sah(const Bvh& bvh, uint32_t max_leaf_size, const SahLeafCosts& costs) {
   if (bvh.empty()) return bvh;
   const size_t n = bvh.nodes.size();
-  std::vector<uint32_t> count(n);
-  std::vector<float> cost(n);
-  std::vector<uint8_t> as_leaf(n);
+  // Fresh arrays written whole: populated first (huge_pages.h), not faulted in page by page.
+  std::vector<uint32_t> count;
+  std::vector<float> cost;
+  std::vector<uint8_t> as_leaf;
+  reserve_on_huge_pages(count, n);
+  reserve_on_huge_pages(cost, n);
+  reserve_on_huge_pages(as_leaf, n);
+  count.resize(n);
+  cost.resize(n);
+  as_leaf.resize(n);
   // Children come after their parents (bvh.h): from the back, every child is priced first.
   for (size_t i = n; i-- > 0;) {
     const BvhNode& node = bvh.nodes[i];
@@ -43,8 +52,8 @@ Bvh collapse_leaves_by_sah(const Bvh& bvh, uint32_t max_leaf_size, const SahLeaf
   }
   // Top down, depth first, each interior node's children side by side.
   Bvh out;
-  out.nodes.reserve(n);
-  out.prim_indices.reserve(bvh.prim_indices.size());
+  out.nodes.reserve(n);  // room for all, of which the merged leaves leave some unwritten
+  reserve_on_huge_pages(out.prim_indices, bvh.prim_indices.size());
   struct Item {
     uint32_t from, to;  // a node of `bvh`, and its place in `out`
   };
