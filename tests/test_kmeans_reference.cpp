@@ -22,7 +22,7 @@ namespace {
 
 // Measured (g++, Release): over 12 seeds the mean costs agree within 0.6% on every case here
 // (bunny within 0.8%), while one seed's cost spreads by up to 3%. Production candidates drawn
-// without their index (p = 1 in effect) fail the test on 10 cases. Left out: the outliers
+// without their index (p = 1 in effect) fail 9 of its 18 cases. Left out: the outliers
 // stress case, whose 12-seed means still wander by 1-5% (another compiler's draws put the
 // reference 5% above), too noisy to tell a loss from the draws.
 constexpr uint32_t kSeeds = 12;

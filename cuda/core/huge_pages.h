@@ -20,7 +20,7 @@ void advise_huge_pages(const void* p, size_t bytes);
 // (MADV_POPULATE_WRITE, Linux 5.14): the kernel allocates and zeroes them as the first
 // writes would, without a fault for each. On this project's virtual machines a fault costs
 // about 16 us, most of it the trap, so a 1 MiB array under the 2 MiB of a huge page costs
-// 7 ms written fresh and about 1 ms populated first. For memory that is about to be written
+// about 3 ms written fresh and 1 ms populated first. For memory that is about to be written
 // whole; where the kernel cannot, the pages fault as before.
 void populate_pages(const void* p, size_t bytes);
 
