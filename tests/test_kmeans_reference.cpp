@@ -6,7 +6,6 @@
 // show here as a dearer tree than the reference's.
 #include <gtest/gtest.h>
 
-#include <numeric>
 #include <string>
 #include <vector>
 

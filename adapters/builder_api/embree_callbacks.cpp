@@ -31,14 +31,6 @@ struct EmitWorkspace : BuildContext::Workspace {
 
 namespace {
 
-// v.assign(n, value), the storage on huge pages when it grows.
-template <typename T>
-void assign_on_huge_pages(std::vector<T>& v, size_t n, const T& value) {
-  v.clear();
-  reserve_on_huge_pages(v, n);
-  v.assign(n, value);
-}
-
 constexpr uint32_t kMaxBranching = 16;       // the widest node Embree 3 makes
 constexpr uint32_t kTaskPrimitives = 4096;   // subtrees this large are emitted as tasks of their own
 

@@ -34,4 +34,12 @@ void reserve_on_huge_pages(std::vector<T>& v, size_t n) {
   populate_pages(v.data() + v.size(), (n - v.size()) * sizeof(T));
 }
 
+// v.assign(n, value), the storage on huge pages (and populated) when it grows.
+template <typename T>
+void assign_on_huge_pages(std::vector<T>& v, size_t n, const T& value) {
+  v.clear();
+  reserve_on_huge_pages(v, n);
+  v.assign(n, value);
+}
+
 }  // namespace kmbvh

@@ -26,12 +26,9 @@ Bvh collapse_leaves_by_sah(const Bvh& bvh, uint32_t max_leaf_size, const SahLeaf
   std::vector<uint32_t> count;
   std::vector<float> cost;
   std::vector<uint8_t> as_leaf;
-  reserve_on_huge_pages(count, n);
-  reserve_on_huge_pages(cost, n);
-  reserve_on_huge_pages(as_leaf, n);
-  count.resize(n);
-  cost.resize(n);
-  as_leaf.resize(n);
+  assign_on_huge_pages(count, n, 0u);
+  assign_on_huge_pages(cost, n, 0.0f);
+  assign_on_huge_pages(as_leaf, n, uint8_t(0));
   // Children come after their parents (bvh.h): from the back, every child is priced first.
   for (size_t i = n; i-- > 0;) {
     const BvhNode& node = bvh.nodes[i];
