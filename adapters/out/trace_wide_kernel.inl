@@ -273,14 +273,15 @@ template <Query query, Confirm confirm, typename Count>
 __attribute__((always_inline)) inline int confirm_hits(const TrianglePack& p, const TrianglePack* packs,
                                                        const PackRay& r, float tnear, Search& s, vfp t,
                                                        unsigned hits, unsigned redo, Candidate& c, Count& count) {
-  auto vertex = [&](int v, int slot) { return slot_vertex(p, v, uint32_t(slot)); };
+  // (The lambdas are forced inline too: an occlusion query's `accept` was left a call.)
+  auto vertex = [&](int v, int slot) __attribute__((always_inline)) { return slot_vertex(p, v, uint32_t(slot)); };
   const bool prior = s.found_key != kNoCandidate;
   int best = -1;
   float& t_hit = c.t;
   double& exact = c.exact;
   exact = kUnmeasured;
   double slot_exact = kUnmeasured;  // the exact t of the slot `beats` last measured
-  auto beats = [&](int slot, float ts) {
+  auto beats = [&](int slot, float ts) __attribute__((always_inline)) {
     slot_exact = kUnmeasured;
     if (best < 0 && !prior) return true;  // the test admitted it within (tnear, tfar]
     const float tb = best < 0 ? s.tmax : t_hit;
@@ -305,7 +306,7 @@ __attribute__((always_inline)) inline int confirm_hits(const TrianglePack& p, co
   // Whether `slot` counts; for Exact and Interval, measured against (tnear, end]: tfar for
   // the first candidate, then a little past the closest one's float t (cull_reach), which
   // may be an ulp below the exact t of both when they are coincident.
-  auto accept = [&](int slot) {
+  auto accept = [&](int slot) __attribute__((always_inline)) {
     const float end = best < 0 ? (prior ? cull_reach(s.tmax) : s.tmax) : cull_reach(t_hit);
     if constexpr (confirm == Confirm::Deferred) {
       c.bound = end;

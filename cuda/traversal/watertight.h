@@ -141,7 +141,7 @@ struct ExactEdges {
 
 // t, u, v of the ray's meeting with the triangle's plane from its own edges, in double
 // precision; false when the ray is parallel to the plane.
-KMBVH_HD KMBVH_INLINE bool exact_hit(const Ray& ray, Vec3 a, const ExactEdges& e, double& t, double& u, double& v) {
+KMBVH_HD KMBVH_FORCE_INLINE bool exact_hit(const Ray& ray, Vec3 a, const ExactEdges& e, double& t, double& u, double& v) {
   const double dx = ray.dir.x, dy = ray.dir.y, dz = ray.dir.z;
   const double px = dy * e.e2z - dz * e.e2y, py = dz * e.e2x - dx * e.e2z, pz = dx * e.e2y - dy * e.e2x;
   const double det = e.e1x * px + e.e1y * py + e.e1z * pz;
@@ -158,7 +158,7 @@ KMBVH_HD KMBVH_INLINE bool exact_hit(const Ray& ray, Vec3 a, const ExactEdges& e
 // exact_hit's t alone, the same measure exact_check reports; NaN when the ray is parallel
 // to the plane. Orders two candidates whose float t are too close to be trusted (the wide
 // traversal's confirm_hits).
-KMBVH_HD KMBVH_INLINE double exact_distance(const Ray& ray, Vec3 a, Vec3 b, Vec3 c) {
+KMBVH_HD KMBVH_FORCE_INLINE double exact_distance(const Ray& ray, Vec3 a, Vec3 b, Vec3 c) {
   double t, u, v;
   return exact_hit(ray, a, ExactEdges(a, b, c), t, u, v) ? t : double(NAN);
 }
@@ -178,7 +178,7 @@ struct ExactCheck {
 // ray leaving a needle then hits the needle itself, behind it. Checked on accepted hits
 // only, a few per ray; the same measure gives the hit's refined t, u and v, so the hit
 // that stands is not measured twice.
-KMBVH_HD KMBVH_INLINE ExactCheck exact_check(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, float tnear, float tmax) {
+KMBVH_HD KMBVH_FORCE_INLINE ExactCheck exact_check(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, float tnear, float tmax) {
   ExactCheck check;
   double t, u, v;
   if (!exact_hit(ray, a, ExactEdges(a, b, c), t, u, v)) return check;
@@ -195,7 +195,7 @@ KMBVH_HD KMBVH_INLINE ExactCheck exact_check(const Ray& ray, Vec3 a, Vec3 b, Vec
 // compared with the interval as T against tnear * det and tmax * det, det's sign taken
 // out), about half the work. A ray parallel to the plane in double is left to the float
 // test, as there.
-KMBVH_HD KMBVH_INLINE bool exact_within(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, float tnear, float tmax) {
+KMBVH_HD KMBVH_FORCE_INLINE bool exact_within(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, float tnear, float tmax) {
   const ExactEdges e(a, b, c);
   const double dx = ray.dir.x, dy = ray.dir.y, dz = ray.dir.z;
   const double px = dy * e.e2z - dz * e.e2y, py = dz * e.e2x - dx * e.e2z, pz = dx * e.e2y - dy * e.e2x;
@@ -214,7 +214,7 @@ KMBVH_HD KMBVH_INLINE bool exact_within(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, 
 // So the closest hit, once known, reports t, u, v and Ng measured from the triangle's own
 // edges in double precision: t, u, v and Ng correct to float precision. `check` is that
 // triangle's exact_check, made when it was accepted.
-KMBVH_HD KMBVH_INLINE void apply_exact_check(const ExactCheck& check, Vec3 a, Vec3 b, Vec3 c, Hit& hit) {
+KMBVH_HD KMBVH_FORCE_INLINE void apply_exact_check(const ExactCheck& check, Vec3 a, Vec3 b, Vec3 c, Hit& hit) {
   if (!check.measured) return;
   hit.u = check.u;
   hit.v = check.v;
