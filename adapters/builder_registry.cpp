@@ -95,12 +95,12 @@ BuilderConfig parse_builder(const std::string& spec) {
   const std::optional<BuilderKind> kind = builder_kind(name);
   if (!kind)
     throw std::invalid_argument(fmt::format(
-        "unknown builder '{}' (sweep-sah, lbvh, hlbvh, atrbvh, ploc, kmeans, Q1..Q5, QA, Q1S..Q5S, QAS, "
+        "unknown builder '{}' (sweep-sah, lbvh, hlbvh, atrbvh, ploc, kmeans, Q1..Q5, QA, Q1S..Q5S, QAS, Q1R..Q5R, QAR, "
         "embree-low|medium|high)", spec));
   config.builder = *kind;
   if (*kind == BuilderKind::Kmeans) {
     const auto params = kmeans_preset(preset);
-    if (!params) throw std::invalid_argument(fmt::format("unknown k-means preset '{}' (Q1 to Q5, QA, each of them followed by S)", preset));
+    if (!params) throw std::invalid_argument(fmt::format("unknown k-means preset '{}' (Q1 to Q5, QA, each of them alone or followed by S or R)", preset));
     config.kmeans = *params;
     config.preset = preset;
     for (char& c : config.preset) c = char(std::toupper(static_cast<unsigned char>(c)));

@@ -36,6 +36,20 @@ TEST(KMeansGpu, ValidTreesAsGoodAsTheCpuBackend) {
       }
 }
 
+// The R presets: k-means on the device, the treelet passes of restructure_tree.inl too.
+TEST(KMeansGpu, RestructuredTreeletsAsGoodAsTheCpuBackend) {
+  if (!cuda_device_available()) GTEST_SKIP() << "no CUDA device";
+  const PrimitiveSet prims = make_primitive_set(test::clustered_triangles(200000, 57));
+  for (const char* preset : {"Q2R", "Q3R"}) {
+    const KMeansParams params = *kmeans_preset(preset);
+    const Bvh gpu = build_kmeans(prims, params, Backend::Cuda);
+    const Bvh cpu = build_kmeans(prims, params, Backend::Cpu);
+    const ValidationReport report = validate(gpu, prims, ValidationLimits{});
+    EXPECT_TRUE(report.ok()) << preset << ": " << report.summary();
+    EXPECT_NEAR(sah_cost(gpu) / sah_cost(cpu), 1.0, 0.02) << preset;
+  }
+}
+
 // A build context on the GPU: the rebuild allocates no device memory and builds the same tree.
 TEST(KMeansGpu, RebuildInAContextAllocatesNothing) {
   if (!cuda_device_available()) GTEST_SKIP() << "no CUDA device";

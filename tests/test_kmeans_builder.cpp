@@ -234,7 +234,7 @@ TEST_P(Degenerate, SharedCentroidAndZeroArea) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(KMeans, Degenerate, ::testing::Values("Q1", "Q2", "Q3", "Q4", "Q5", "QA", "Q3S"));
+INSTANTIATE_TEST_SUITE_P(KMeans, Degenerate, ::testing::Values("Q1", "Q2", "Q3", "Q4", "Q5", "QA", "Q3S", "Q2R"));
 
 }  // namespace
 }  // namespace kmbvh

@@ -54,4 +54,14 @@ Bvh build_ploc(const PrimitiveSet& p, const BinaryBuildParams& q, Backend b, Bui
   return dispatch(detail::build_ploc_cpu, KMBVH_GPU(ploc), p, q, b, i, c);
 }
 
+Bvh restructure_treelets(const PrimitiveSet& p, const Bvh& t, const BinaryBuildParams& q, Backend b, BuildInfo* i,
+                         BuildContext* c) {
+  if (const std::string problem = check_params(q); !problem.empty()) throw std::invalid_argument(problem);
+  require_backend(b);
+  const CountBackendSteps counting(i ? &i->backend : nullptr);
+#if defined(KMBVH_HAS_CUDA)
+  if (b == Backend::Cuda) return detail::restructure_treelets_gpu(p, t, q, i, c);
+#endif
+  return detail::restructure_treelets_cpu(p, t, q, i, c);
+}
 }  // namespace kmbvh

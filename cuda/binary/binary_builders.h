@@ -24,6 +24,12 @@ Bvh build_atrbvh(const PrimitiveSet& prims, const BinaryBuildParams& params, Bac
                  BuildInfo* info = nullptr, BuildContext* context = nullptr);
 Bvh build_ploc(const PrimitiveSet& prims, const BinaryBuildParams& params, Backend backend = Backend::Cpu,
                BuildInfo* info = nullptr, BuildContext* context = nullptr);
+// ATRBVH's treelet restructuring and SAH leaf collapse over a tree another builder made for
+// `prims` (any arity, any leaf size: it is split into one primitive a leaf first), with
+// `params`' treelet size, passes, leaf size and SAH costs. Throws std::invalid_argument
+// when the tree does not hold each primitive exactly once.
+Bvh restructure_treelets(const PrimitiveSet& prims, const Bvh& tree, const BinaryBuildParams& params,
+                         Backend backend = Backend::Cpu, BuildInfo* info = nullptr, BuildContext* context = nullptr);
 
 namespace detail {
 #define KMBVH_DECLARE_BINARY_BUILDER(name)                                                             \
@@ -36,6 +42,10 @@ KMBVH_DECLARE_BINARY_BUILDER(hlbvh)
 KMBVH_DECLARE_BINARY_BUILDER(atrbvh)
 KMBVH_DECLARE_BINARY_BUILDER(ploc)
 #undef KMBVH_DECLARE_BINARY_BUILDER
+Bvh restructure_treelets_cpu(const PrimitiveSet& prims, const Bvh& tree, const BinaryBuildParams& params,
+                             BuildInfo* info, BuildContext* context);
+Bvh restructure_treelets_gpu(const PrimitiveSet& prims, const Bvh& tree, const BinaryBuildParams& params,
+                             BuildInfo* info, BuildContext* context);
 }  // namespace detail
 
 }  // namespace kmbvh

@@ -4,6 +4,7 @@
 #include "../lbvh/lbvh.inl"
 #include "../hlbvh/hlbvh.inl"
 #include "../atrbvh/atrbvh.inl"
+#include "../atrbvh/restructure_tree.inl"
 #include "../ploc/ploc.inl"
 #include "binary_builders.h"
 
@@ -20,6 +21,11 @@ Bvh build_atrbvh_cpu(const PrimitiveSet& p, const BinaryBuildParams& q, BuildInf
 }
 Bvh build_ploc_cpu(const PrimitiveSet& p, const BinaryBuildParams& q, BuildInfo* i, BuildContext* c) {
   return cpu_backend::in_context(c, "binary/cpu", [&] { return cpu_backend::build_ploc(p, q, i); });
+}
+
+Bvh restructure_treelets_cpu(const PrimitiveSet& p, const Bvh& t, const BinaryBuildParams& q, BuildInfo* i,
+                            BuildContext* c) {
+  return cpu_backend::in_context(c, "binary/cpu", [&] { return cpu_backend::restructure_treelets(p, t, q, i); });
 }
 
 }  // namespace kmbvh::detail

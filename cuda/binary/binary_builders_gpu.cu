@@ -3,6 +3,7 @@
 #include "../lbvh/lbvh.inl"
 #include "../hlbvh/hlbvh.inl"
 #include "../atrbvh/atrbvh.inl"
+#include "../atrbvh/restructure_tree.inl"
 #include "../ploc/ploc.inl"
 #include "binary_builders.h"
 
@@ -19,6 +20,11 @@ Bvh build_atrbvh_gpu(const PrimitiveSet& p, const BinaryBuildParams& q, BuildInf
 }
 Bvh build_ploc_gpu(const PrimitiveSet& p, const BinaryBuildParams& q, BuildInfo* i, BuildContext* c) {
   return gpu_backend::in_context(c, "binary/gpu", [&] { return gpu_backend::build_ploc(p, q, i); });
+}
+
+Bvh restructure_treelets_gpu(const PrimitiveSet& p, const Bvh& t, const BinaryBuildParams& q, BuildInfo* i,
+                            BuildContext* c) {
+  return gpu_backend::in_context(c, "binary/gpu", [&] { return gpu_backend::restructure_treelets(p, t, q, i); });
 }
 
 }  // namespace kmbvh::detail

@@ -4,6 +4,7 @@
 #include <chrono>
 #include <stdexcept>
 
+#include "../binary/binary_builders.h"
 #include "../core/sah_leaves.h"
 
 namespace kmbvh {
@@ -25,6 +26,16 @@ Bvh build_kmeans(const PrimitiveSet& prims, const KMeansParams& params, Backend 
                  BuildContext* context) {
   if (const std::string problem = check_params(params); !problem.empty()) throw std::invalid_argument(problem);
   require_backend(backend);
+  if (params.restructure_passes > 0) {
+    KMeansParams fine = params;
+    fine.max_leaf_size = 1;
+    fine.restructure_passes = 0;
+    const Bvh clustered = build_on(backend, prims, fine, info, context);
+    BinaryBuildParams binary;
+    binary.max_leaf_size = params.max_leaf_size;
+    binary.treelet_iterations = params.restructure_passes;
+    return restructure_treelets(prims, clustered, binary, backend, info, context);
+  }
   if (!params.sah_leaves) return build_on(backend, prims, params, info, context);
   // SAH leaves: the clusters go down to a few primitives, then the SAH picks the leaves.
   KMeansParams fine = params;

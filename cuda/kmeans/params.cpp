@@ -4,6 +4,8 @@
 
 #include <cctype>
 
+#include "../binary/binary_params.h"
+
 namespace kmbvh {
 namespace {
 
@@ -17,8 +19,10 @@ constexpr Preset kPresets[] = {
     {"Q1", 8, 5, 0, false},   {"Q2", 8, 5, 2, false},   {"Q3", 16, 5, 5, false},
     {"Q4", 32, 20, 10, false}, {"Q5", 64, 30, 15, false}, {"QA", 64, 30, 15, true},
 };
-constexpr const char* kNames[] = {"Q1",  "Q2",  "Q3",  "Q4",  "Q5",  "QA",
-                                  "Q1S", "Q2S", "Q3S", "Q4S", "Q5S", "QAS", nullptr};
+constexpr const char* kNames[] = {"Q1",  "Q2",  "Q3",  "Q4",  "Q5",  "QA",  "Q1S", "Q2S", "Q3S", "Q4S",
+                                  "Q5S", "QAS", "Q1R", "Q2R", "Q3R", "Q4R", "Q5R", "QAR", nullptr};
+// The R presets' passes: ATRBVH's own default (cuda/binary/binary_params.h).
+constexpr uint32_t kRestructurePasses = 2;
 
 std::string upper(std::string s) {
   for (char& c : s) c = char(std::toupper(static_cast<unsigned char>(c)));
@@ -30,11 +34,13 @@ std::string upper(std::string s) {
 std::optional<KMeansParams> kmeans_preset(const std::string& name) {
   std::string wanted = upper(name);
   const bool sah_leaves = wanted.size() == 3 && wanted.back() == 'S';
-  if (sah_leaves) wanted.pop_back();
+  const bool restructure = wanted.size() == 3 && wanted.back() == 'R';
+  if (sah_leaves || restructure) wanted.pop_back();
   for (const Preset& preset : kPresets) {
     if (wanted != preset.name) continue;
     KMeansParams params;
     params.sah_leaves = sah_leaves;
+    params.restructure_passes = restructure ? kRestructurePasses : 0;
     params.k = preset.k;
     params.p = preset.p;
     params.i = preset.i;
@@ -62,6 +68,13 @@ std::string check_params(const KMeansParams& params) {
     return fmt::format("the max leaf size m must be in [1, 255], got {}", params.max_leaf_size);
   if (!(params.settle_fraction >= 0.0f && params.settle_fraction <= 1.0f))
     return fmt::format("the settle fraction must be in [0, 1], got {}", params.settle_fraction);
+  if (params.restructure_passes > 0 && (params.wide || params.sah_leaves))
+    return "restructured treelets make a binary tree with its own SAH leaves: not with --wide or SAH leaves";
+  if (params.restructure_passes > 100)
+    return fmt::format("restructuring passes must be at most 100, got {}", params.restructure_passes);
+  if (params.restructure_passes > 0 && params.max_leaf_size > BinaryBuildParams::kMaxLeafSize)
+    return fmt::format("restructured treelets take leaves of at most {} primitives, got m = {}",
+                       BinaryBuildParams::kMaxLeafSize, params.max_leaf_size);
   if (params.i > 1000) return fmt::format("i (Lloyd iterations) must be at most 1000, got {}", params.i);
   return {};
 }
