@@ -478,15 +478,24 @@ __attribute__((always_inline)) inline bool descend(const WideBvh<W>& bvh, const 
         cur = WideEntry{n.ref[lane], n.count[lane], entry[lane]};
         continue;
       }
-      if (query == Query::Any) {  // any hit will do: no ordering
-        stack[sp++] = WideEntry{n.ref[lane], n.count[lane], entry[lane]};
-        prefetch_child(bvh, n.ref[lane], n.count[lane]);
-        for (; mask; mask &= mask - 1) {
-          lane = __builtin_ctz(mask);
-          stack[sp++] = WideEntry{n.ref[lane], n.count[lane], entry[lane]};
-          prefetch_child(bvh, n.ref[lane], n.count[lane]);
+      if (query == Query::Any) {
+        // Any hit will do, so no sorting; but the child entered farthest away is taken
+        // next and the others pushed as they come. Occlusion rays start on a surface
+        // (shadow and ambient-occlusion rays), so the boxes nearest their origin hold the
+        // surface they leave, which cannot occlude them. Sponza's recorded occlusion rays
+        // over embree-medium's tree: 5.4 nodes a ray in lane order, 4.1 farthest first
+        // (8.2 nearest first; all sorted far to near, 4.1 but slower than this).
+        int far = lane;
+        for (unsigned rest = mask; rest; rest &= rest - 1) {
+          const int l = __builtin_ctz(rest);
+          far = entry[l] > entry[far] ? l : far;
         }
-        cur = stack[--sp];
+        for (unsigned rest = (mask | 1u << lane) & ~(1u << far); rest; rest &= rest - 1) {
+          const int l = __builtin_ctz(rest);
+          stack[sp++] = WideEntry{n.ref[l], n.count[l], entry[l]};
+          prefetch_child(bvh, n.ref[l], n.count[l]);
+        }
+        cur = WideEntry{n.ref[far], n.count[far], entry[far]};
         continue;
       }
       // Several: the nearest is taken next, the others go on the stack farthest first.
