@@ -71,7 +71,7 @@ PluginConfig read_plugin_config() {
   }
   if (!env("KMBVH_PRESET").empty()) {
     if (!kmeans_preset(env("KMBVH_PRESET")))
-      throw std::invalid_argument("KMBVH_PRESET=" + env("KMBVH_PRESET") + ": expected Q1, Q2, Q3, Q4, Q5 or QA, or one of them followed by S (SAH leaves)");
+      throw std::invalid_argument("KMBVH_PRESET=" + env("KMBVH_PRESET") + ": expected Q1, Q2, Q3, Q4, Q5 or QA, or one of them followed by S (SAH leaves) or R (treelets restructured)");
     c.preset = env("KMBVH_PRESET");
   }
   c.k = env_count("KMBVH_K", 2, KMeansParams::kMaxK);
@@ -116,7 +116,7 @@ BuilderConfig builder_for(const PluginConfig& config, RTCBuildQuality quality) {
   // MEDIUM take the k-means configuration nearest to dominating Embree's build of that
   // quality on the shared scenes; HIGH, where Embree's rtcBuildBVH builds MEDIUM's tree in
   // MEDIUM's time, the one with the lowest SAH cost, the faster of equals.
-  if (preset.empty()) preset = quality == RTC_BUILD_QUALITY_LOW ? "Q1" : quality == RTC_BUILD_QUALITY_HIGH ? "Q3S" : "Q2S";
+  if (preset.empty()) preset = quality == RTC_BUILD_QUALITY_LOW ? "Q1" : quality == RTC_BUILD_QUALITY_HIGH ? "Q3R" : "Q2S";
   BuilderConfig b = parse_builder("kmeans:" + preset);
   if (config.k || config.p || config.i) b.preset.clear();
   if (config.k) b.kmeans.k = config.k;
