@@ -8,6 +8,7 @@
 #pragma once
 
 #include <stdexcept>
+#include <string>
 #include <vector>
 
 namespace kmbvh {

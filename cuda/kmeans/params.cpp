@@ -21,8 +21,6 @@ constexpr Preset kPresets[] = {
 };
 constexpr const char* kNames[] = {"Q1",  "Q2",  "Q3",  "Q4",  "Q5",  "QA",  "Q1S", "Q2S", "Q3S", "Q4S",
                                   "Q5S", "QAS", "Q1R", "Q2R", "Q3R", "Q4R", "Q5R", "QAR", nullptr};
-// The R presets' passes: ATRBVH's own default (cuda/binary/binary_params.h).
-constexpr uint32_t kRestructurePasses = 2;
 
 std::string upper(std::string s) {
   for (char& c : s) c = char(std::toupper(static_cast<unsigned char>(c)));
@@ -40,7 +38,7 @@ std::optional<KMeansParams> kmeans_preset(const std::string& name) {
     if (wanted != preset.name) continue;
     KMeansParams params;
     params.sah_leaves = sah_leaves;
-    params.restructure_passes = restructure ? kRestructurePasses : 0;
+    params.restructure_passes = restructure ? BinaryBuildParams{}.treelet_iterations : 0;  // ATRBVH's own
     params.k = preset.k;
     params.p = preset.p;
     params.i = preset.i;
