@@ -16,7 +16,7 @@
 // checks the CPU traversal makes on most rays (watertight.h). Out of line they are compiled
 // for the file's baseline instruction set, so every call from the AVX kernels spilled the
 // kernel's vector registers: inlined, spot's primary rays ran 0.75 -> 0.90 of Embree's speed
-// (docs/design.md §8).
+// (docs/design.md §9, instruction sets).
 
 // True while nvcc compiles the device side of a translation unit.
 #if defined(__CUDA_ARCH__)
