@@ -43,9 +43,9 @@ struct KMeansParams {
   static constexpr uint32_t kSahLeafCluster = 3;
   // Treelets restructured (a configuration beyond the paper, the presets with an R): cluster
   // down to one primitive a leaf, then ATRBVH's agglomerative treelet passes over the tree
-  // and leaves collapsed by SAH (cuda/atrbvh/restructure_tree.inl). The treelets undo the
-  // overlap of the clusters' boxes near the leaves, where k-means trees lose most to SAH
-  // builders (docs/design.md §4). 0: off; otherwise the passes.
+  // and leaves collapsed by SAH (cuda/atrbvh/restructure_tree.inl). The treelets regroup
+  // the clusters' overlapping boxes in the levels near the leaves (docs/design.md §4).
+  // 0: off; otherwise the passes.
   uint32_t restructure_passes = 0;
 
   static constexpr uint32_t kMaxK = 64;  // local arrays in the kernels are sized by this
