@@ -4,19 +4,15 @@
 // the level loop's steps as the loop is written.
 #include <gtest/gtest.h>
 
-#include <cstring>
-
 #include "cuda/binary/binary_builders.h"
 #include "cuda/kmeans/kmeans_builder.h"
+#include "support/same_tree.h"
 #include "support/scenes.h"
 
 namespace kmbvh {
 namespace {
 
-bool same_tree(const Bvh& a, const Bvh& b) {
-  return a.nodes.size() == b.nodes.size() && a.prim_indices == b.prim_indices &&
-         std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(BvhNode)) == 0;
-}
+using test::same_tree;
 
 class EveryConfiguration : public ::testing::TestWithParam<const char*> {};
 

@@ -3,13 +3,12 @@
 // the degenerate inputs.
 #include <gtest/gtest.h>
 
-#include <cstring>
-
 #include "cuda/core/threads.h"
 #include "cuda/kmeans/kmeans_builder.h"
 #include "cuda/kmeans/node_rules.h"
 #include "cuda/metrics/tree_stats.h"
 #include "cuda/metrics/validate.h"
+#include "support/same_tree.h"
 #include "support/scenes.h"
 
 namespace kmbvh {
@@ -31,10 +30,7 @@ void expect_valid(const PrimitiveSet& prims, const KMeansParams& params, const s
                            << (params.wide ? " wide" : "") << ": " << report.summary();
 }
 
-bool same_tree(const Bvh& a, const Bvh& b) {
-  return a.nodes.size() == b.nodes.size() && a.prim_indices == b.prim_indices &&
-         std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(BvhNode)) == 0;
-}
+using test::same_tree;
 
 class EveryPreset : public ::testing::TestWithParam<const char*> {};
 

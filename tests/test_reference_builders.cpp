@@ -5,7 +5,6 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
-#include <cstring>
 #include <functional>
 #include <random>
 #include <set>
@@ -18,6 +17,7 @@
 #include "cuda/core/threads.h"
 #include "cuda/metrics/tree_stats.h"
 #include "cuda/sweep_sah/sweep_sah.h"
+#include "support/same_tree.h"
 #include "support/scenes.h"
 
 namespace kmbvh {
@@ -25,10 +25,7 @@ namespace {
 
 const char* const kReferenceBuilders[] = {"sweep-sah", "lbvh", "hlbvh", "atrbvh", "ploc"};
 
-bool same_tree(const Bvh& a, const Bvh& b) {
-  return a.nodes.size() == b.nodes.size() && a.prim_indices == b.prim_indices &&
-         std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(BvhNode)) == 0;
-}
+using test::same_tree;
 
 void expect_valid(const BuilderConfig& config, const PrimitiveSet& prims, const std::string& what) {
   const Bvh bvh = run_builder(config, prims);

@@ -4,7 +4,6 @@
 // a clear error for a tree that does not hold the primitive set.
 #include <gtest/gtest.h>
 
-#include <cstring>
 #include <stdexcept>
 
 #include "adapters/builder_registry.h"
@@ -13,6 +12,7 @@
 #include "cuda/kmeans/kmeans_builder.h"
 #include "cuda/metrics/sah.h"
 #include "cuda/metrics/validate.h"
+#include "support/same_tree.h"
 #include "support/scenes.h"
 
 namespace kmbvh {
@@ -25,10 +25,7 @@ ValidationLimits binary_leaves_up_to(uint32_t m) {
   return limits;
 }
 
-bool same_tree(const Bvh& a, const Bvh& b) {
-  return a.nodes.size() == b.nodes.size() && a.prim_indices == b.prim_indices &&
-         std::memcmp(a.nodes.data(), b.nodes.data(), a.nodes.size() * sizeof(BvhNode)) == 0;
-}
+using test::same_tree;
 
 // The passes only ever replace a treelet by a cheaper one, so the tree after them costs no
 // more than the same tree collapsed without them; any input shape (k-means' binary

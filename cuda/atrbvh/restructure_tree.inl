@@ -87,20 +87,7 @@ inline Bvh restructure_treelets(const PrimitiveSet& prims, const Bvh& input, con
   const InputBoxes boxes(prims.boxes);
   for_each_index(n, InitLeaves{tree, state.view(), params.sah, boxes.data()});
   collapse(tree, state, params.max_leaf_size, params.sah, /*refit=*/true);  // boxes, counts, costs
-  Buffer<uint32_t> visits(n - 1);
-  for (uint32_t pass = 0; pass < params.treelet_iterations; ++pass) {
-    if (info) ++info->levels;
-    thrust::fill(launch(), visits.begin(), visits.end(), 0u);
-    for_each_index(n, climb_from_leaves(tree, ptr(visits), RestructureTreelet{tree, state.view(), params.sah,
-                                                                             params.max_leaf_size,
-                                                                             params.treelet_size}));
-  }
-  release(visits);
-  clock.lap("restructure");
-  collapse(tree, state, params.max_leaf_size, params.sah, /*refit=*/true);
-  Bvh bvh = lay_out(tree, state.view());
-  clock.lap("layout");
-  return bvh;
+  return restructure_collapse_and_lay_out(tree, state, params, info, clock);
 }
 
 }  // namespace KMBVH_BACKEND_NAMESPACE
