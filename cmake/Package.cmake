@@ -6,7 +6,7 @@
 #   kmbvh::embree  libkmbvh_embree.so: Embree's builder API served by kmbvh, and the
 #                  one-line swap header (kmbvh/embree_swap.h)
 # plus libkmbvh_preload.so (LD_PRELOAD into an unmodified Embree application) and, with
-# the tools, the kmbvh command. Headers go under P/include/kmbvh, in the source tree's
+# the tools, the kmbvh command (and libkmbvh_image_io.so, the module it writes images with). Headers go under P/include/kmbvh, in the source tree's
 # folders, so that they include one another as they do here.
 include(CMakePackageConfigHelpers)
 include(GNUInstallDirs)
@@ -49,6 +49,8 @@ install(TARGETS kmbvh_library kmbvh_embree EXPORT kmbvhTargets
 install(TARGETS kmbvh_preload LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
 if(KMBVH_TOOLS)
   install(TARGETS kmbvh RUNTIME DESTINATION ${CMAKE_INSTALL_BINDIR})
+  # The image codec the tool opens on its first image (adapters/render/image_io).
+  install(TARGETS kmbvh_image_io LIBRARY DESTINATION ${CMAKE_INSTALL_LIBDIR})
 endif()
 
 set(_kmbvh_headers ${CMAKE_INSTALL_INCLUDEDIR}/kmbvh)

@@ -21,10 +21,11 @@ struct Result {
   std::string out, err;
 };
 
-Result run(const std::string& args) {
+// Runs the kmbvh tool (or `program`, a copy of it) with `args`.
+Result run(const std::string& args, const std::string& program = KMBVH_CLI) {
   static int calls = 0;
   const fs::path err_file = kmbvh::test::temp_path("stderr-" + std::to_string(++calls) + ".txt");
-  const std::string command = std::string(KMBVH_CLI) + " " + args + " 2>" + err_file.string();
+  const std::string command = program + " " + args + " 2>" + err_file.string();
   Result r;
   FILE* pipe = popen(command.c_str(), "r");
   char buffer[4096];
@@ -246,6 +247,20 @@ TEST(Cli, RenderRejectsAViewTheSceneDoesNotHave) {
                        kmbvh::test::temp_path("render-bad").string());
   EXPECT_EQ(r.exit_code, 2);
   EXPECT_NE(r.err.find("has no view 7"), std::string::npos) << r.err;
+}
+
+// The tool opens its image library (adapters/render/image_io) on its first image, from the
+// lib folder beside its own; a copy of the tool without one says so and fails.
+TEST(Cli, RenderWithoutTheImageLibraryFailsNamingIt) {
+  const fs::path lonely = kmbvh::test::temp_path("lonely") / "bin" / "kmbvh";
+  fs::create_directories(lonely.parent_path());
+  fs::copy_file(KMBVH_CLI, lonely, fs::copy_options::overwrite_existing);
+  const Result r = run("render " + small_obj().string() + " --width 8 --height 8 --spp 1 --views 0 -q --out " +
+                           kmbvh::test::temp_path("lonely-images").string(),
+                       lonely.string());
+  EXPECT_EQ(r.exit_code, 1) << r.err;
+  EXPECT_NE(r.err.find("libkmbvh_image_io.so is not installed beside this program"), std::string::npos) << r.err;
+  EXPECT_NE(r.err.find("-view0.png"), std::string::npos) << r.err;  // the image it could not write
 }
 
 TEST(Cli, PaperSuiteJsonHasEveryFieldForEveryRow) {

@@ -1,4 +1,5 @@
-// Rendered images to files and back, through OpenImageIO: PNG for looking at (exposed so
+// Rendered images to files and back, through OpenImageIO (in a module opened on the first
+// image: image_io/CMakeLists.txt says why): PNG for looking at (exposed so
 // that the brightest tenth of the pixels starts at 70% of white, then sRGB, 8 bits) and
 // EXR for comparing (linear, 32-bit float, as rendered).
 #pragma once

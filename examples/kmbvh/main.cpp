@@ -51,7 +51,7 @@ int main(int argc, char** argv) {
     fmt::print(stderr, "kmbvh: error: out of memory\n");
     return kExitBuildFailed;
   } catch (const std::exception& e) {
-    fmt::print(stderr, "kmbvh: build failed: {}\n", e.what());
+    fmt::print(stderr, "kmbvh: error: {}\n", e.what());  // a build, or writing its results
     return kExitBuildFailed;
   }
 }

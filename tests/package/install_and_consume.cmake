@@ -43,6 +43,13 @@ if(EXISTS "${prefix}/bin/kmbvh")  # built with the tools
   if(NOT step_output MATCHES "0\\.2")
     message(FATAL_ERROR "the installed kmbvh says '${step_output}', not version 0.2")
   endif()
+  # Its images go through the codec module it opens from the prefix's lib folder.
+  step("render with the installed kmbvh" "${prefix}/bin/kmbvh" render --width 16 --height 12 --spp 1 --views 0
+       --builder Q1 --out "${WORK_DIR}/images" -q)
+  file(GLOB images "${WORK_DIR}/images/*.png")
+  if(NOT images)
+    message(FATAL_ERROR "the installed kmbvh rendered no image into ${WORK_DIR}/images")
+  endif()
 endif()
 
 # The version file: 0.2 is found, another minor version is not.
