@@ -271,23 +271,26 @@ TEST(Lbvh, RadixTreeMatchesAnIndependentReference) {
 
 TEST(RadixSort, MatchesStableSort) {
   std::mt19937_64 rng(6);
-  for (size_t n : {size_t(0), size_t(1), size_t(2), size_t(1000), size_t(200000)}) {
-    std::vector<uint64_t> keys(n), key_scratch(n);
-    std::vector<uint32_t> values(n), value_scratch(n);
-    for (size_t i = 0; i < n; ++i) {
-      keys[i] = (rng() >> 4) & (i % 3 == 0 ? 0xffull : ~0ull >> 4);  // many duplicates too
-      values[i] = uint32_t(i);
-    }
-    std::vector<std::pair<uint64_t, uint32_t>> expected(n);
-    for (size_t i = 0; i < n; ++i) expected[i] = {keys[i], values[i]};
-    std::stable_sort(expected.begin(), expected.end(),
-                     [](const auto& a, const auto& b) { return a.first < b.first; });
-    set_thread_count(2);
-    radix_sort_pairs(keys.data(), values.data(), n, 60, key_scratch.data(), value_scratch.data());
-    set_thread_count(0);
-    for (size_t i = 0; i < n; ++i) {
-      ASSERT_EQ(keys[i], expected[i].first) << i;
-      ASSERT_EQ(values[i], expected[i].second) << i;
+  // Morton codes' 60 bits, and a width that is no multiple of the sort's digit.
+  for (const int key_bits : {60, 37}) {
+    for (size_t n : {size_t(0), size_t(1), size_t(2), size_t(1000), size_t(200000)}) {
+      std::vector<uint64_t> keys(n), key_scratch(n);
+      std::vector<uint32_t> values(n), value_scratch(n);
+      for (size_t i = 0; i < n; ++i) {
+        keys[i] = (rng() >> (64 - key_bits)) & (i % 3 == 0 ? 0xffull : ~0ull);  // many duplicates too
+        values[i] = uint32_t(i);
+      }
+      std::vector<std::pair<uint64_t, uint32_t>> expected(n);
+      for (size_t i = 0; i < n; ++i) expected[i] = {keys[i], values[i]};
+      std::stable_sort(expected.begin(), expected.end(),
+                       [](const auto& a, const auto& b) { return a.first < b.first; });
+      set_thread_count(2);
+      radix_sort_pairs(keys.data(), values.data(), n, key_bits, key_scratch.data(), value_scratch.data());
+      set_thread_count(0);
+      for (size_t i = 0; i < n; ++i) {
+        ASSERT_EQ(keys[i], expected[i].first) << key_bits << " bits, " << i;
+        ASSERT_EQ(values[i], expected[i].second) << key_bits << " bits, " << i;
+      }
     }
   }
 }
