@@ -4,6 +4,7 @@
 
 #include <exception>
 #include <string>
+#include <type_traits>
 
 #include "image_codec.h"
 
@@ -54,3 +55,7 @@ extern "C" __attribute__((visibility("default"))) int kmbvh_image_read(const cha
     return failed(e.what(), error, error_size);
   }
 }
+
+// The functions image_file.cpp looks up by name have the types it calls them with.
+static_assert(std::is_same_v<decltype(&kmbvh_image_write), kmbvh_image_write_fn>);
+static_assert(std::is_same_v<decltype(&kmbvh_image_read), kmbvh_image_read_fn>);
