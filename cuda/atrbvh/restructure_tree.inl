@@ -85,8 +85,7 @@ inline Bvh restructure_treelets(const PrimitiveSet& prims, const Bvh& input, con
   const BinaryTreeView tree = binary.view();
   CollapseState state(n);
   const InputBoxes boxes(prims.boxes);
-  for_each_index(n, InitLeaves{tree, state.view(), params.sah, boxes.data()});
-  collapse(tree, state, params.max_leaf_size, params.sah, /*refit=*/true);  // boxes, counts, costs
+  collapse(tree, state, params.max_leaf_size, params.sah, /*refit=*/true, boxes.data());  // boxes, counts, costs
   return restructure_collapse_and_lay_out(tree, state, params, info, clock);
 }
 

@@ -24,12 +24,14 @@ struct CollapseState {
   CollapseView view() { return {ptr(count), ptr(cost), ptr(collapsed)}; }
 };
 
-// Costs and collapse flags for a tree whose topology is final. The leaves' boxes must be
-// set; with refit, inner boxes are computed on the way up, else they must be set too.
-inline void collapse(const BinaryTreeView& tree, CollapseState& state, uint32_t max_leaf_size, SahCosts k, bool refit) {
+// Costs and collapse flags for a tree whose topology is final. The leaves' boxes are set
+// from prim_boxes when given, else they must be set already; with refit, inner boxes are
+// computed on the way up, else they must be set too.
+inline void collapse(const BinaryTreeView& tree, CollapseState& state, uint32_t max_leaf_size, SahCosts k, bool refit,
+                     const Aabb* prim_boxes = nullptr) {
   Buffer<uint32_t> visits(tree.n - 1);
   thrust::fill(launch(), visits.begin(), visits.end(), 0u);
-  for_each_index(tree.n, InitLeaves{tree, state.view(), k, nullptr});
+  for_each_index(tree.n, InitLeaves{tree, state.view(), k, prim_boxes});
   for_each_index(tree.n, climb_from_leaves(tree, ptr(visits), CollapseNode{tree, state.view(), k, max_leaf_size, refit}));
 }
 
