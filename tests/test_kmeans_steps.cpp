@@ -3,6 +3,9 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <cfloat>
+#include <cmath>
+#include <cstring>
 #include <vector>
 
 #include "cuda/core/counter_rng.h"
@@ -103,6 +106,79 @@ void check_nearest_against_brute_force() {
 TEST(Assign, NearestRepresentativeMatchesBruteForceMeans) { check_nearest_against_brute_force<ClusterMetric::Means>(); }
 TEST(Assign, NearestRepresentativeMatchesBruteForceMedians) {
   check_nearest_against_brute_force<ClusterMetric::Medians>();
+}
+
+// Boxes whose coordinates come from a palette of the cases that decide ties and NaNs:
+// zeros of both signs, overflowing magnitudes, infinities, NaN, and repeats.
+std::vector<Aabb> awkward_boxes(uint32_t n, uint32_t seed) {
+  const float palette[] = {0.0f, -0.0f, 1.0f, -1.0f, 0.5f, 1e30f, -1e30f, FLT_MAX, -FLT_MAX, INFINITY, -INFINITY, NAN};
+  const uint32_t size = sizeof(palette) / sizeof(palette[0]);
+  std::vector<Aabb> boxes(n);
+  for (uint32_t i = 0; i < n; ++i) {
+    float c[6];
+    for (uint32_t d = 0; d < 6; ++d) {
+      const uint32_t pick = counter_uniform(seed, 7, 6 * i + d, size + 4);
+      c[d] = pick < size ? palette[pick] : test::random_unit(seed, 8, 6 * i + d);
+    }
+    boxes[i] = Aabb(Vec3(c[0], c[1], c[2]), Vec3(c[3], c[4], c[5]));
+  }
+  return boxes;
+}
+
+// The host's SSE2 paths (assign.h) against the scalar definitions they replace, bit for bit:
+// the trees of the CPU and GPU backends and of the subtree path must stay the same.
+template <ClusterMetric M>
+void check_vector_nearest_is_scalar() {
+  const auto plain = random_boxes(500, 11);
+  const auto awkward = awkward_boxes(3000, 12);
+  for (uint32_t k : {1u, 2u, 3u, 4u, 5u, 8u, 13u, 16u, 64u}) {
+    for (const auto* reps_from : {&plain, &awkward}) {
+      std::vector<Aabb> reps(reps_from->begin() + 7, reps_from->begin() + 7 + k);
+      if (k > 2) reps[k - 1] = reps[1];  // a tie
+      RepresentativeTable<64, M> table;
+      table.load(reps.data(), k);
+      for (const auto* boxes : {&plain, &awkward})
+        for (const Aabb& b : *boxes) ASSERT_EQ(table.nearest(b), table.nearest_scalar(b)) << "k=" << k << " " << b;
+    }
+  }
+}
+
+TEST(Assign, HostNearestIsTheScalarDefinitionMeans) {
+  if (!KMBVH_HOST_SSE2) GTEST_SKIP() << "no SSE2 path on this host";
+  check_vector_nearest_is_scalar<ClusterMetric::Means>();
+}
+TEST(Assign, HostNearestIsTheScalarDefinitionMedians) {
+  if (!KMBVH_HOST_SSE2) GTEST_SKIP() << "no SSE2 path on this host";
+  check_vector_nearest_is_scalar<ClusterMetric::Medians>();
+}
+
+TEST(Assign, AccumulatorsAreTheScalarDefinitions) {
+  auto same_bits = [](const auto& a, const auto& b) { return std::memcmp(&a, &b, sizeof(a)) == 0; };
+  for (const auto& boxes : {random_boxes(1000, 13), awkward_boxes(1000, 14)}) {
+    constexpr uint32_t k = 5;
+    BoundsAccumulator<8> bounds;
+    SumAccumulator<8> sums;
+    bounds.clear(k);
+    sums.clear(k);
+    Aabb expected_box[k];
+    double expected_sum[k][6] = {};
+    for (uint32_t c = 0; c < k; ++c) expected_box[c] = Aabb::empty();
+    for (uint32_t i = 0; i < boxes.size(); ++i) {
+      const uint32_t c = i % k;
+      bounds.add(c, boxes[i]);
+      sums.add(c, boxes[i]);
+      expected_box[c].grow(boxes[i]);
+      for (int d = 0; d < 3; ++d) {
+        expected_sum[c][d] += boxes[i].lo[d];
+        expected_sum[c][3 + d] += boxes[i].hi[d];
+      }
+    }
+    for (uint32_t c = 0; c < k; ++c) {
+      const Aabb box = bounds.box(c);
+      EXPECT_TRUE(same_bits(box, expected_box[c])) << box << " against " << expected_box[c];
+      EXPECT_TRUE(same_bits(sums.sum[c], expected_sum[c])) << "cluster " << c;
+    }
+  }
 }
 
 TEST(UpdateMeans, FixedPointMeanEqualsExactMean) {

@@ -3,8 +3,17 @@
 // the next step needs in locals, and publishes it once per cluster.
 #pragma once
 
+#include <cmath>
 #include <cstdint>
 #include <type_traits>
+
+// SSE2 on the host side of x86-64 (the device side of a .cu file has none).
+#if defined(__SSE2__) && !defined(__CUDA_ARCH__)
+#define KMBVH_HOST_SSE2 1
+#include <emmintrin.h>
+#else
+#define KMBVH_HOST_SSE2 0
+#endif
 
 #include "distance.h"
 #include "level.h"
@@ -13,10 +22,13 @@
 namespace kmbvh {
 
 // One segment's representatives as six coordinate rows, so that the distances to all of
-// them are computed by one vectorisable loop.
+// them are computed by one vectorisable loop. On the host, four at a time with SSE2 (every
+// x86-64 CPU has it): the rows are padded to a multiple of four with +inf, whose distance
+// (+inf, or NaN for an infinite coordinate) never wins.
 template <uint32_t KMax, ClusterMetric M>
 struct RepresentativeTable {
-  float coord[6][KMax];
+  static_assert(KMax % 4 == 0, "rows are padded to whole groups of four");
+  alignas(16) float coord[6][KMax];
   uint32_t k = 0;
 
   KMBVH_HD void load(const Aabb* reps, uint32_t k_) {
@@ -26,10 +38,22 @@ struct RepresentativeTable {
         coord[d][j] = reps[j].lo[d];
         coord[3 + d][j] = reps[j].hi[d];
       }
+    for (uint32_t j = k; j < ((k + 3) & ~3u); ++j)
+      for (int d = 0; d < 6; ++d) coord[d][j] = INFINITY;
   }
 
-  // Ties go to the lowest index; a NaN distance never wins.
+  // Ties go to the lowest index; a NaN distance never wins (and a NaN distance to the
+  // first representative keeps it).
   KMBVH_HD uint32_t nearest(const Aabb& b) const {
+#if KMBVH_HOST_SSE2
+    return nearest_sse2(b);
+#else
+    return nearest_scalar(b);
+#endif
+  }
+
+  // The definition: one distance after the other, the first strictly smaller one wins.
+  KMBVH_HD uint32_t nearest_scalar(const Aabb& b) const {
     const float v[6] = {b.lo.x, b.lo.y, b.lo.z, b.hi.x, b.hi.y, b.hi.z};
     float dist[KMax];
     for (uint32_t j = 0; j < k; ++j) {
@@ -52,6 +76,44 @@ struct RepresentativeTable {
       }
     return best;
   }
+
+#if KMBVH_HOST_SSE2
+  // The same answer as nearest_scalar, bit for bit: each distance is summed in the same
+  // order (no fused multiply-add: the build uses -ffp-contract=off), NaNs become +inf
+  // (minps returns its second operand when either is NaN), and the first lane equal to the
+  // smallest distance wins. The CPU subtree path spends most of its time here (Q1 on
+  // conference: docs/design.md §4).
+  uint32_t nearest_sse2(const Aabb& b) const {
+    const __m128 v[6] = {_mm_set1_ps(b.lo.x), _mm_set1_ps(b.lo.y), _mm_set1_ps(b.lo.z),
+                         _mm_set1_ps(b.hi.x), _mm_set1_ps(b.hi.y), _mm_set1_ps(b.hi.z)};
+    const __m128 inf = _mm_set1_ps(INFINITY);
+    const __m128 sign = _mm_set1_ps(-0.0f);
+    const uint32_t groups = (k + 3) / 4;
+    __m128 dist[KMax / 4];
+    __m128 smallest = inf;
+    float first = 0.0f;
+    for (uint32_t g = 0; g < groups; ++g) {
+      __m128 s = _mm_setzero_ps();
+      for (int d = 0; d < 6; ++d) {
+        const __m128 t = _mm_sub_ps(v[d], _mm_load_ps(&coord[d][4 * g]));
+        if constexpr (M == ClusterMetric::Means)
+          s = _mm_add_ps(s, _mm_mul_ps(t, t));
+        else
+          s = _mm_add_ps(s, _mm_andnot_ps(sign, t));
+      }
+      if (g == 0) first = _mm_cvtss_f32(s);
+      dist[g] = _mm_min_ps(s, inf);  // NaN -> +inf
+      smallest = _mm_min_ps(smallest, dist[g]);
+    }
+    if (first != first) return 0;
+    smallest = _mm_min_ps(smallest, _mm_shuffle_ps(smallest, smallest, _MM_SHUFFLE(2, 3, 0, 1)));
+    smallest = _mm_min_ps(smallest, _mm_shuffle_ps(smallest, smallest, _MM_SHUFFLE(1, 0, 3, 2)));
+    for (uint32_t g = 0; g < groups; ++g)
+      if (const int hits = _mm_movemask_ps(_mm_cmpeq_ps(dist[g], smallest)))
+        return 4 * g + uint32_t(__builtin_ctz(unsigned(hits)));
+    return 0;  // unreachable: the smallest lane is one of them
+  }
+#endif
 };
 
 enum class AssignPass : uint8_t {
@@ -63,17 +125,27 @@ enum class AssignPass : uint8_t {
 // Locals of a Sums pass: plain double sums per cluster, encoded once per piece.
 template <uint32_t KMax>
 struct SumAccumulator {
-  double sum[KMax][6];
+  alignas(16) double sum[KMax][6];  // lo.x, lo.y, lo.z, hi.x, hi.y, hi.z
 
   KMBVH_HD void clear(uint32_t k) {
     for (uint32_t c = 0; c < k; ++c)
       for (int d = 0; d < 6; ++d) sum[c][d] = 0.0;
   }
   KMBVH_HD void add(uint32_t c, const Aabb& b) {
+#if KMBVH_HOST_SSE2
+    // Two components a vector, in memory order: the same additions, bit for bit.
+    const float* f = &b.lo.x;
+    const __m128 first = _mm_loadu_ps(f), last = _mm_loadu_ps(f + 2);  // lx ly lz hx, lz hx hy hz
+    double* s = sum[c];
+    _mm_store_pd(s, _mm_add_pd(_mm_load_pd(s), _mm_cvtps_pd(first)));
+    _mm_store_pd(s + 2, _mm_add_pd(_mm_load_pd(s + 2), _mm_cvtps_pd(_mm_movehl_ps(first, first))));
+    _mm_store_pd(s + 4, _mm_add_pd(_mm_load_pd(s + 4), _mm_cvtps_pd(_mm_movehl_ps(last, last))));
+#else
     for (int d = 0; d < 3; ++d) {
       sum[c][d] += b.lo[d];
       sum[c][3 + d] += b.hi[d];
     }
+#endif
   }
   // sole: this piece is its segment's only one, so plain stores suffice.
   KMBVH_HD void publish(uint32_t c, uint32_t n, const FixedPointFrame& frame, bool sole, ClusterSums& out) const {
@@ -90,17 +162,45 @@ struct SumAccumulator {
 // Locals of a Final pass: cluster bounds.
 template <uint32_t KMax>
 struct BoundsAccumulator {
-  Aabb box[KMax];
+#if KMBVH_HOST_SSE2
+  // A box is six floats: lanes 0-2 of a load at its lo corner and lanes 1-3 of one at lo.z
+  // cover it without reading past it. minps(p, lo) and maxps(p, hi) are vec3.h's min(lo, p)
+  // and max(hi, p) bit for bit, NaNs included; one vector operation per corner instead of
+  // three scalar ones and their partial stores.
+  static_assert(sizeof(Aabb) == 6 * sizeof(float), "a box is its two corners, packed");
+  __m128 lo[KMax], hi[KMax];
+
+  void clear(uint32_t k) {
+    for (uint32_t c = 0; c < k; ++c) {
+      lo[c] = _mm_set1_ps(INFINITY);
+      hi[c] = _mm_set1_ps(-INFINITY);
+    }
+  }
+  void add(uint32_t c, const Aabb& b) {
+    const float* f = &b.lo.x;
+    lo[c] = _mm_min_ps(_mm_loadu_ps(f), lo[c]);
+    hi[c] = _mm_max_ps(_mm_loadu_ps(f + 2), hi[c]);
+  }
+  Aabb box(uint32_t c) const {
+    alignas(16) float l[4], h[4];
+    _mm_store_ps(l, lo[c]);
+    _mm_store_ps(h, hi[c]);
+    return Aabb(Vec3(l[0], l[1], l[2]), Vec3(h[1], h[2], h[3]));
+  }
+#else
+  Aabb boxes[KMax];
 
   KMBVH_HD void clear(uint32_t k) {
-    for (uint32_t c = 0; c < k; ++c) box[c] = Aabb::empty();
+    for (uint32_t c = 0; c < k; ++c) boxes[c] = Aabb::empty();
   }
-  KMBVH_HD void add(uint32_t c, const Aabb& b) { box[c].grow(b); }
+  KMBVH_HD void add(uint32_t c, const Aabb& b) { boxes[c].grow(b); }
+  KMBVH_HD Aabb box(uint32_t c) const { return boxes[c]; }
+#endif
   KMBVH_HD void publish(uint32_t c, bool sole, OrderedBounds& out) const {
     if (sole)
-      out = OrderedBounds::of(box[c]);
+      out = OrderedBounds::of(box(c));
     else
-      out.atomic_grow(box[c]);
+      out.atomic_grow(box(c));
   }
 };
 

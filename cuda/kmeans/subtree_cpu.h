@@ -172,16 +172,16 @@ class SubtreeSplitter {
   void assign_final(const Aabb* boxes, uint32_t n, uint32_t k, const Aabb* reps, uint32_t* count, Aabb* bounds) {
     RepresentativeTable<KMax, M> table;
     table.load(reps, k);
-    for (uint32_t c = 0; c < k; ++c) {
-      count[c] = 0;
-      bounds[c] = Aabb::empty();
-    }
+    BoundsAccumulator<KMax> acc;
+    acc.clear(k);
+    for (uint32_t c = 0; c < k; ++c) count[c] = 0;
     for (uint32_t x = 0; x < n; ++x) {
       const uint32_t c = table.nearest(boxes[x]);
       cluster_of_[x] = static_cast<uint8_t>(c);
       ++count[c];
-      bounds[c].grow(boxes[x]);
+      acc.add(c, boxes[x]);
     }
+    for (uint32_t c = 0; c < k; ++c) bounds[c] = acc.box(c);
   }
 
   // Stable counting sort by cluster. gather_only: the boxes go to the scratch buffer and
