@@ -72,6 +72,24 @@ TEST(RestructureTreelets, RPresetsAreValidAndTheSameAtOneAndTwoThreads) {
   }
 }
 
+// The R presets skip the breadth-first reorder of the tree they restructure
+// (KMeansParams::breadth_first): their result depends on the tree, not on its numbering.
+TEST(RestructureTreelets, RPresetsAreTheRestructuredBreadthFirstTree) {
+  const PrimitiveSet prims = make_primitive_set(test::clustered_triangles(30000, 15));
+  for (const char* preset : {"Q2R", "QAR"}) {
+    const KMeansParams params = *kmeans_preset(preset);
+    KMeansParams fine = params;
+    fine.max_leaf_size = 1;
+    fine.restructure_passes = 0;
+    ASSERT_TRUE(fine.breadth_first);
+    BinaryBuildParams binary;
+    binary.max_leaf_size = params.max_leaf_size;
+    binary.treelet_iterations = params.restructure_passes;
+    const Bvh expected = restructure_treelets(prims, build_kmeans(prims, fine), binary);
+    EXPECT_TRUE(same_tree(build_kmeans(prims, params), expected)) << preset;
+  }
+}
+
 TEST(RestructureTreelets, DegenerateSets) {
   const KMeansParams params = *kmeans_preset("Q2R");
   for (uint32_t n : {0u, 1u, 2u, 3u, 9u}) {

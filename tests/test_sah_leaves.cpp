@@ -3,11 +3,14 @@
 // merged exactly where the SAH says so.
 #include <gtest/gtest.h>
 
+#include <algorithm>
+
 #include "adapters/builder_registry.h"
 #include "cuda/core/sah_leaves.h"
 #include "cuda/kmeans/kmeans_builder.h"
 #include "cuda/metrics/sah.h"
 #include "cuda/metrics/validate.h"
+#include "support/same_tree.h"
 #include "support/scenes.h"
 
 namespace kmbvh {
@@ -43,6 +46,22 @@ TEST(SahLeaves, ValidAndNeverDearerThanTheTreeTheyStartFrom) {
         }
       }
     }
+  }
+}
+
+// The S presets skip the breadth-first reorder of the tree whose leaves they collapse
+// (KMeansParams::breadth_first): their result depends on the tree, not on its numbering.
+TEST(SahLeaves, SPresetsAreTheCollapsedBreadthFirstTree) {
+  const PrimitiveSet prims = make_primitive_set(test::clustered_triangles(30000, 7));
+  for (const char* preset : {"Q1S", "Q3S", "QAS"}) {
+    const KMeansParams params = *kmeans_preset(preset);
+    ASSERT_TRUE(params.sah_leaves) << preset;
+    KMeansParams fine = params;
+    fine.sah_leaves = false;
+    fine.max_leaf_size = std::min(params.max_leaf_size, KMeansParams::kSahLeafCluster);
+    ASSERT_TRUE(fine.breadth_first);
+    const Bvh expected = collapse_leaves_by_sah(build_kmeans(prims, fine), params.max_leaf_size);
+    EXPECT_TRUE(test::same_tree(build_kmeans(prims, params), expected)) << preset;
   }
 }
 

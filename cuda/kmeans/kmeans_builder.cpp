@@ -30,6 +30,7 @@ Bvh build_kmeans(const PrimitiveSet& prims, const KMeansParams& params, Backend 
     KMeansParams fine = params;
     fine.max_leaf_size = 1;
     fine.restructure_passes = 0;
+    fine.breadth_first = false;
     const Bvh clustered = build_on(backend, prims, fine, info, context);
     BinaryBuildParams binary;
     binary.max_leaf_size = params.max_leaf_size;
@@ -40,6 +41,7 @@ Bvh build_kmeans(const PrimitiveSet& prims, const KMeansParams& params, Backend 
   // SAH leaves: the clusters go down to a few primitives, then the SAH picks the leaves.
   KMeansParams fine = params;
   fine.max_leaf_size = std::min(params.max_leaf_size, KMeansParams::kSahLeafCluster);
+  fine.breadth_first = false;
   const Bvh clustered = build_on(backend, prims, fine, info, context);
   const auto start = std::chrono::steady_clock::now();
   Bvh bvh = collapse_leaves_by_sah(clustered, params.max_leaf_size);

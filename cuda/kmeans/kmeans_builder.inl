@@ -346,10 +346,10 @@ class KMeansLevels {
 #endif
 
   // Copies the tree out: its nodes as built into host memory of the workspace, then in
-  // breadth-first order into the tree returned. Without a context each working buffer is
-  // freed as soon as it is done with, so that the finishing step does not raise the build's
-  // peak memory; a context's keep theirs for the next build, so that only the tree returned
-  // is fresh memory.
+  // breadth-first order (or as built: params.breadth_first) into the tree returned. Without
+  // a context each working buffer is freed as soon as it is done with, so that the
+  // finishing step does not raise the build's peak memory; a context's keep theirs for the
+  // next build, so that only the tree returned is fresh memory.
   Bvh finish() {
     if (!keep_)
       release(boxes_[0], boxes_[1], ids_[0], ids_[1], cluster_of_, segments_, next_segments_, segment_offsets_,
@@ -374,7 +374,12 @@ class KMeansLevels {
     bvh.prim_indices = to_host(final_ids_, n_);
     if (!keep_) release(final_ids_);
     if (info_) info_->forced_splits += read(forced_, 0);
-    bvh.nodes = breadth_first_nodes(built.data(), total, ws_.order_scratch);
+    if (params_.breadth_first) {
+      bvh.nodes = breadth_first_nodes(built.data(), total, ws_.order_scratch);
+    } else {
+      reserve_on_huge_pages(bvh.nodes, total);
+      bvh.nodes.assign(built.begin(), built.begin() + total);
+    }
     clock_.lap("finish");
     return bvh;
   }

@@ -32,6 +32,11 @@ struct KMeansParams {
   // depth-first (subtree_cpu.h). The tree is the same either way; false runs every level
   // through the portable level loop, as the GPU does.
   bool cpu_subtrees = true;
+  // The paper's finishing step: the nodes in breadth-first order. false leaves them in the
+  // order they were made (children after their parent and side by side, as Bvh requires),
+  // for a caller that lays the tree out again anyway: the S and R presets, whose SAH leaves
+  // and treelets depend on the tree alone, not on its node numbering.
+  bool breadth_first = true;
   // Leaves chosen by SAH (a configuration beyond the paper): cluster down to at most
   // kSahLeafCluster primitives, then make each subtree of at most m primitives a leaf where
   // the SAH prefers it (cuda/core/sah_leaves.h). false: the paper's rule, every cluster of
