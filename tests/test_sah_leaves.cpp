@@ -4,9 +4,13 @@
 #include <gtest/gtest.h>
 
 #include <algorithm>
+#include <functional>
+#include <utility>
+#include <vector>
 
 #include "adapters/builder_registry.h"
 #include "cuda/core/sah_leaves.h"
+#include "cuda/core/threads.h"
 #include "cuda/kmeans/kmeans_builder.h"
 #include "cuda/metrics/sah.h"
 #include "cuda/metrics/validate.h"
@@ -46,6 +50,87 @@ TEST(SahLeaves, ValidAndNeverDearerThanTheTreeTheyStartFrom) {
         }
       }
     }
+  }
+}
+
+// The sequential definition the parallel passes of collapse_leaves_by_sah must reproduce:
+// price every node from the back (children come after parents), then write the tree top
+// down, depth first, each interior node's children side by side.
+Bvh sequential_sah_leaves(const Bvh& bvh, uint32_t max_leaf_size, const SahLeafCosts& costs = {}) {
+  const size_t n = bvh.nodes.size();
+  std::vector<uint32_t> count(n);
+  std::vector<float> cost(n);
+  std::vector<uint8_t> as_leaf(n);
+  for (size_t i = n; i-- > 0;) {
+    const BvhNode& node = bvh.nodes[i];
+    const float area = node.box.surface_area();
+    if (node.is_leaf()) {
+      count[i] = node.count;
+      cost[i] = costs.intersection * float(node.count) * area;
+      as_leaf[i] = 1;
+      continue;
+    }
+    uint32_t primitives = 0;
+    float split = costs.traversal * area;
+    for (uint32_t c = node.first; c < node.first + node.count; ++c) primitives += count[c], split += cost[c];
+    const float leaf = costs.intersection * float(primitives) * area;
+    count[i] = primitives;
+    as_leaf[i] = primitives <= max_leaf_size && leaf <= split;
+    cost[i] = as_leaf[i] ? leaf : split;
+  }
+  Bvh out;
+  out.nodes.emplace_back();
+  std::vector<std::pair<uint32_t, uint32_t>> stack{{0, 0}};  // (input node, output node)
+  std::function<void(uint32_t)> gather = [&](uint32_t node) {
+    const BvhNode& b = bvh.nodes[node];
+    if (b.is_leaf()) {
+      out.prim_indices.insert(out.prim_indices.end(), bvh.prim_indices.begin() + b.first,
+                              bvh.prim_indices.begin() + b.first + b.count);
+      return;
+    }
+    for (uint32_t c = 0; c < b.count; ++c) gather(b.first + c);
+  };
+  while (!stack.empty()) {
+    const auto [from, to] = stack.back();
+    stack.pop_back();
+    const BvhNode& node = bvh.nodes[from];
+    if (as_leaf[from]) {
+      const auto first = uint32_t(out.prim_indices.size());
+      gather(from);
+      out.nodes[to] = BvhNode::make_leaf(node.box, first, count[from]);
+      continue;
+    }
+    const auto first = uint32_t(out.nodes.size());
+    out.nodes.resize(out.nodes.size() + node.count);
+    out.nodes[to] = BvhNode::make_interior(node.box, first, node.count);
+    for (uint32_t c = node.count; c-- > 0;) stack.push_back({node.first + c, first + c});
+  }
+  return out;
+}
+
+// Large trees are priced and written by subtrees in parallel: the same tree, byte for byte,
+// as the sequential passes, at one thread and at two, binary and k-ary, leaves of one to
+// three primitives below, from 1 to 8 above (and one tree small enough for one subtree).
+TEST(SahLeaves, ParallelPassesMakeTheSequentialTree) {
+  for (const uint32_t triangles : {300u, 60000u}) {
+    const PrimitiveSet prims = make_primitive_set(test::clustered_triangles(triangles, 9));
+    for (const bool wide : {false, true})
+      for (const uint32_t fine_leaf : {1u, 3u}) {
+        KMeansParams fine = *kmeans_preset("Q2");
+        fine.wide = wide;
+        fine.max_leaf_size = fine_leaf;
+        const Bvh bvh = build_kmeans(prims, fine);
+        for (const uint32_t m : {1u, 4u, 8u}) {
+          const Bvh expected = sequential_sah_leaves(bvh, m);
+          for (const int threads : {1, 2}) {
+            set_thread_count(threads);
+            EXPECT_TRUE(test::same_tree(collapse_leaves_by_sah(bvh, m), expected))
+                << triangles << " triangles" << (wide ? ", wide" : "") << ", leaves of " << fine_leaf << ", m=" << m
+                << ", " << threads << " threads";
+          }
+          set_thread_count(0);
+        }
+      }
   }
 }
 

@@ -10,6 +10,12 @@
 namespace kmbvh {
 namespace {
 
+// The SAH leaves' per-node arrays, kept in the build context from one build to the next.
+struct SahLeavesWorkspace : BuildContext::Workspace {
+  SahLeavesScratch scratch;
+  size_t bytes_held() const override { return scratch.bytes_held(); }
+};
+
 Bvh build_on(Backend backend, const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info,
              BuildContext* context) {
 #if defined(KMBVH_HAS_CUDA)
@@ -44,7 +50,8 @@ Bvh build_kmeans(const PrimitiveSet& prims, const KMeansParams& params, Backend 
   fine.breadth_first = false;
   const Bvh clustered = build_on(backend, prims, fine, info, context);
   const auto start = std::chrono::steady_clock::now();
-  Bvh bvh = collapse_leaves_by_sah(clustered, params.max_leaf_size);
+  SahLeavesScratch* scratch = context ? &context->workspace<SahLeavesWorkspace>("sah_leaves").scratch : nullptr;
+  Bvh bvh = collapse_leaves_by_sah(clustered, params.max_leaf_size, {}, scratch);
   if (info)
     info->add_phase("sah leaves",
                     std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());
