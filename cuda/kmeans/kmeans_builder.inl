@@ -346,10 +346,10 @@ class KMeansLevels {
 #endif
 
   // Copies the tree out: its nodes as built into host memory of the workspace, then in
-  // breadth-first order (or as built: params.breadth_first) into the tree returned. Without
-  // a context each working buffer is freed as soon as it is done with, so that the
-  // finishing step does not raise the build's peak memory; a context's keep theirs for the
-  // next build, so that only the tree returned is fresh memory.
+  // breadth-first order into the tree returned (as built, params.breadth_first: straight
+  // into the tree returned). Without a context each working buffer is freed as soon as it
+  // is done with, so that the finishing step does not raise the build's peak memory; a
+  // context's keep theirs for the next build, so that only the tree returned is fresh memory.
   Bvh finish() {
     if (!keep_)
       release(boxes_[0], boxes_[1], ids_[0], ids_[1], cluster_of_, segments_, next_segments_, segment_offsets_,
@@ -360,8 +360,11 @@ class KMeansLevels {
     std::vector<uint32_t> offset;
     total = place_subtrees(offset);
 #endif
-    std::vector<BvhNode>& built = ws_.built_nodes;
-    if (built.size() < total) {  // kept at its largest: no zero fill when it fits
+    // Breadth first, the nodes are gathered in the workspace and reordered into the tree;
+    // as built, they are gathered into the tree itself.
+    Bvh bvh;
+    std::vector<BvhNode>& built = params_.breadth_first ? ws_.built_nodes : bvh.nodes;
+    if (built.size() < total) {  // the workspace's is kept at its largest: no zero fill when it fits
       reserve_on_huge_pages(built, total);
       built.resize(total);
     }
@@ -370,16 +373,10 @@ class KMeansLevels {
 #if KMBVH_CPU_SUBTREES
     append_subtrees(built.data(), offset);
 #endif
-    Bvh bvh;
     bvh.prim_indices = to_host(final_ids_, n_);
     if (!keep_) release(final_ids_);
     if (info_) info_->forced_splits += read(forced_, 0);
-    if (params_.breadth_first) {
-      bvh.nodes = breadth_first_nodes(built.data(), total, ws_.order_scratch);
-    } else {
-      reserve_on_huge_pages(bvh.nodes, total);
-      bvh.nodes.assign(built.begin(), built.begin() + total);
-    }
+    if (params_.breadth_first) bvh.nodes = breadth_first_nodes(built.data(), total, ws_.order_scratch);
     clock_.lap("finish");
     return bvh;
   }
