@@ -25,6 +25,9 @@
 #include <thrust/sequence.h>
 #include <thrust/transform_scan.h>
 
+#include <algorithm>
+#include <atomic>
+#include <stdexcept>
 #include <utility>
 
 #include "../core/portable.h"
@@ -73,6 +76,7 @@ struct KMeansWorkspace : BuildContext::Workspace {
   Buffer<ChildCounts> child_counts, child_offsets;
   Buffer<uint32_t> forced;  // segments split by index, counted on the device
   Buffer<BvhNode> nodes;
+  Buffer<BvhNode> subtree_nodes;  // the CPU subtree path's (split_subtrees)
   // Host memory of the finishing step: the nodes as built, and the breadth-first order's scratch.
   std::vector<BvhNode> built_nodes;
   std::vector<uint32_t> order_scratch;
@@ -85,7 +89,7 @@ struct KMeansWorkspace : BuildContext::Workspace {
            bytes_reserved(pieces) + bytes_reserved(piece_counters) + bytes_reserved(counters_scanned) +
            bytes_reserved(reps) + bytes_reserved(sums) + bytes_reserved(counts) + bytes_reserved(bounds) + bytes_reserved(cluster_begin) +
            bytes_reserved(cluster_segment) + bytes_reserved(child_counts) + bytes_reserved(child_offsets) +
-           bytes_reserved(forced) + bytes_reserved(nodes);
+           bytes_reserved(forced) + bytes_reserved(nodes) + bytes_reserved(subtree_nodes);
   }
 };
 
@@ -295,6 +299,13 @@ class KMeansLevels {
     Aabb* boxes = ptr(boxes_[current_]);
     uint32_t* ids = ptr(ids_[current_]);
     uint32_t* final_ids = ptr(final_ids_);
+    // Each work item copies its subtree's nodes to the next free run of one array of huge
+    // pages, kept in the workspace: 2n entries hold any subtrees of n primitives in all, and
+    // only the entries used are touched. (A vector per subtree came from the malloc heap, on
+    // 4 KiB pages: the largest source of page faults in a process's first build.)
+    grow_to(subtree_nodes_, 2 * size_t(n_));
+    BvhNode* const runs = ptr(subtree_nodes_);
+    const size_t capacity = subtree_nodes_.size();
     uint32_t forced = 0;
     ParallelErrors errors;
     count_launch();
@@ -303,10 +314,16 @@ class KMeansLevels {
       SubtreeSplitter<KMax, M> splitter(params_);
 #pragma omp for schedule(dynamic, 1)
       for (int64_t t = 0; t < int64_t(small.size()); ++t)
-        errors.capture([&] { done[t] = splitter.split(small[t], boxes, ids, final_ids, forced); });
+        errors.capture([&] {
+          const std::vector<BvhNode>& nodes = splitter.split(small[t], boxes, ids, final_ids, forced);
+          const size_t first = subtree_used_.fetch_add(nodes.size(), std::memory_order_relaxed);
+          if (first + nodes.size() > capacity) throw std::logic_error("k-means: subtree nodes beyond their bound");
+          std::copy(nodes.begin(), nodes.end(), runs + first);
+          done[t] = {small[t].node, first, uint32_t(nodes.size())};
+        });
     }
     errors.rethrow();
-    for (SubtreeNodes& d : done) subtrees_.push_back(std::move(d));
+    subtrees_.insert(subtrees_.end(), done.begin(), done.end());
     if (info_) info_->forced_splits += forced;
     clock_.lap("subtrees");
     return kept;
@@ -319,30 +336,34 @@ class KMeansLevels {
     size_t total = node_count_;
     for (size_t t = 0; t < subtrees_.size(); ++t) {
       offset[t] = static_cast<uint32_t>(total);
-      total += subtrees_[t].nodes.size() - 1;
+      total += subtrees_[t].count - 1;
     }
     return total;
   }
 
   // Writes the subtrees' nodes into `nodes`, after the level loop's, renumbered.
   void append_subtrees(BvhNode* nodes, const std::vector<uint32_t>& offset) {
+    const BvhNode* runs = ptr(subtree_nodes_);
 #pragma omp parallel for schedule(dynamic, 16)
     for (int64_t t = 0; t < int64_t(subtrees_.size()); ++t) {
       const SubtreeNodes& sub = subtrees_[t];
+      const BvhNode* local = runs + sub.first;
       auto renumber = [&](BvhNode n) {
         if (!n.is_leaf()) n.first = offset[t] + n.first - 1;  // children are never local node 0
         return n;
       };
-      const BvhNode root = renumber(sub.nodes[0]);
+      const BvhNode root = renumber(local[0]);
       nodes[sub.root].first = root.first;
       nodes[sub.root].count = root.count;
       nodes[sub.root].leaf = root.leaf;
-      for (size_t i = 1; i < sub.nodes.size(); ++i) nodes[offset[t] + i - 1] = renumber(sub.nodes[i]);
+      for (uint32_t i = 1; i < sub.count; ++i) nodes[offset[t] + i - 1] = renumber(local[i]);
     }
     std::vector<SubtreeNodes>().swap(subtrees_);
+    if (!keep_) release(subtree_nodes_);
   }
 
   std::vector<SubtreeNodes> subtrees_;
+  std::atomic<size_t> subtree_used_{0};  // entries of subtree_nodes_ handed out
 #endif
 
   // Copies the tree out: its nodes as built into host memory of the workspace, then in
@@ -415,6 +436,7 @@ class KMeansLevels {
   Buffer<ChildCounts>& child_offsets_ = ws_.child_offsets;
   Buffer<uint32_t>& forced_ = ws_.forced;
   Buffer<BvhNode>& nodes_ = ws_.nodes;
+  Buffer<BvhNode>& subtree_nodes_ = ws_.subtree_nodes;  // the CPU subtree path's runs
   uint32_t node_count_ = 0;
   SegmentSizes sizes_;  // what the current level's segments take in all (set_up)
 };

@@ -26,11 +26,13 @@
 
 namespace kmbvh {
 
-// Nodes made by one work item, numbered locally: node 0 stands for the subtree's root
-// (its segment's node in the level loop's array), the others are new.
+// Where a split subtree's nodes are: `count` of them from `first` on in the build's array of
+// subtree nodes, numbered locally: node 0 stands for the subtree's root (its segment's node
+// in the level loop's array), the others are new.
 struct SubtreeNodes {
   uint32_t root = 0;  // the segment's node in the level loop's array
-  std::vector<BvhNode> nodes;
+  size_t first = 0;
+  uint32_t count = 0;
 };
 
 template <uint32_t KMax, ClusterMetric M>
@@ -39,11 +41,14 @@ class SubtreeSplitter {
   explicit SubtreeSplitter(const KMeansParams& params) : params_(params) {}
 
   // Splits everything under `root`, reordering its range of boxes and ids in place and
-  // writing the output order of its primitives into final_ids.
-  SubtreeNodes split(const Segment& root, Aabb* boxes, uint32_t* ids, uint32_t* final_ids, uint32_t& forced_splits) {
-    SubtreeNodes out;
-    out.root = root.node;
-    out.nodes.push_back(BvhNode::make_interior(root.box, 0, 0));
+  // writing the output order of its primitives into final_ids. Returns the subtree's nodes,
+  // numbered locally (SubtreeNodes), in the splitter's own array: reused by the next split,
+  // so a work item allocates nothing once it has split its largest subtree. A subtree of c
+  // primitives has at most 2c - 1 nodes (every interior node has two children or more).
+  const std::vector<BvhNode>& split(const Segment& root, Aabb* boxes, uint32_t* ids, uint32_t* final_ids,
+                                    uint32_t& forced_splits) {
+    nodes_.clear();
+    nodes_.push_back(BvhNode::make_interior(root.box, 0, 0));
     scratch_boxes_.resize(root.count);
     scratch_ids_.resize(root.count);
     cluster_of_.resize(root.count);
@@ -52,9 +57,9 @@ class SubtreeSplitter {
     while (!pending_.empty()) {
       const Pending p = pending_.back();
       pending_.pop_back();
-      forced_splits += split_node(p, boxes + p.begin, ids + p.begin, final_ids + p.begin, out.nodes);
+      forced_splits += split_node(p, boxes + p.begin, ids + p.begin, final_ids + p.begin, nodes_);
     }
-    return out;
+    return nodes_;
   }
 
  private:
@@ -210,6 +215,7 @@ class SubtreeSplitter {
   std::vector<uint32_t> scratch_ids_;
   std::vector<uint8_t> cluster_of_;
   std::vector<Pending> pending_;
+  std::vector<BvhNode> nodes_;
 };
 
 }  // namespace kmbvh
