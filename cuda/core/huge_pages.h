@@ -34,6 +34,16 @@ void reserve_on_huge_pages(std::vector<T>& v, size_t n) {
   populate_pages(v.data() + v.size(), (n - v.size()) * sizeof(T));
 }
 
+// v grown to at least n elements, the storage on huge pages (and populated) when it grows;
+// a larger v is kept as it is, and its elements are not rewritten: working arrays kept from
+// one build to the next, which the build writes before it reads.
+template <typename T>
+void grow_on_huge_pages(std::vector<T>& v, size_t n) {
+  if (v.size() >= n) return;
+  reserve_on_huge_pages(v, n);
+  v.resize(n);
+}
+
 // v.assign(n, value), the storage on huge pages (and populated) when it grows.
 template <typename T>
 void assign_on_huge_pages(std::vector<T>& v, size_t n, const T& value) {

@@ -9,16 +9,6 @@
 namespace kmbvh {
 namespace {
 
-// v resized to n, on populated huge pages when it grows; kept entries are not rewritten.
-template <typename T>
-void size_for(std::vector<T>& v, size_t n) {
-  if (v.capacity() < n) {
-    v.clear();
-    reserve_on_huge_pages(v, n);
-  }
-  v.resize(n);
-}
-
 // Children come after their parents (bvh.h): from the back, every child is priced before
 // its parent, in one sequential pass over the nodes (faster than any split of it: the
 // subtrees' nodes are scattered, and a pass that follows them misses the cache at each).
@@ -113,10 +103,10 @@ Bvh collapse_leaves_by_sah(const Bvh& bvh, uint32_t max_leaf_size, const SahLeaf
   const size_t n = bvh.nodes.size();
   SahLeavesScratch own;
   SahLeavesScratch& p = scratch ? *scratch : own;
-  size_for(p.count, n);
-  size_for(p.nodes, n);
-  size_for(p.cost, n);
-  size_for(p.as_leaf, n);
+  grow_on_huge_pages(p.count, n);
+  grow_on_huge_pages(p.nodes, n);
+  grow_on_huge_pages(p.cost, n);
+  grow_on_huge_pages(p.as_leaf, n);
   price(bvh, max_leaf_size, costs, p);
 
   // The top of the tree, breadth first, opened until enough subtrees hang below it for each

@@ -385,10 +385,7 @@ class KMeansLevels {
     // as built, they are gathered into the tree itself.
     Bvh bvh;
     std::vector<BvhNode>& built = params_.breadth_first ? ws_.built_nodes : bvh.nodes;
-    if (built.size() < total) {  // the workspace's is kept at its largest: no zero fill when it fits
-      reserve_on_huge_pages(built, total);
-      built.resize(total);
-    }
+    grow_on_huge_pages(built, total);  // the workspace's is kept at its largest: no zero fill when it fits
     copy_to_host(ptr(nodes_), node_count_, built.data());
     if (!keep_) release(nodes_);
 #if KMBVH_CPU_SUBTREES
