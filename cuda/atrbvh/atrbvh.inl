@@ -39,7 +39,7 @@ inline Bvh build_atrbvh(const PrimitiveSet& prims, const BinaryBuildParams& para
   PhaseClock clock(info);
   MortonRadixTree radix;
   CollapseState state(n);
-  build_morton_radix_tree(prims, radix, state, params, /*with_ranges=*/false, clock);
+  build_morton_radix_tree(prims, radix, state, params, RadixTreeParts{}, clock);
   release(radix.codes);
   return restructure_collapse_and_lay_out(radix.view(), state, params, info, clock);
 }

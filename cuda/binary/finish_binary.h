@@ -67,7 +67,10 @@ inline Bvh lay_out(const BinaryTreeView& tree, CollapseView view, const uint32_t
       const uint32_t ahead = queue[i + kAhead];
       __builtin_prefetch(&view.collapsed[ahead]);
       __builtin_prefetch(&tree.box[ahead]);
-      if (!tree.is_leaf(ahead)) __builtin_prefetch(&tree.left[tree.inner(ahead)]), __builtin_prefetch(&tree.right[tree.inner(ahead)]);
+      if (!tree.is_leaf(ahead)) {
+        __builtin_prefetch(&tree.left[tree.inner(ahead)]);
+        __builtin_prefetch(&tree.right[tree.inner(ahead)]);
+      }
     }
     const uint32_t node = queue[i];
     const Aabb box = tree.box[node];
@@ -79,7 +82,8 @@ inline Bvh lay_out(const BinaryTreeView& tree, CollapseView view, const uint32_t
       continue;
     }
     if (range_first) {
-      nodes.push_back(BvhNode::make_leaf(box, tree.is_leaf(node) ? node : range_first[tree.inner(node)], view.count[node]));
+      const uint32_t first = tree.is_leaf(node) ? node : range_first[tree.inner(node)];
+      nodes.push_back(BvhNode::make_leaf(box, first, view.count[node]));
       continue;
     }
     // The leaves under the node, left to right (at most max-leaf-size of them).

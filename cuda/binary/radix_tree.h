@@ -27,8 +27,8 @@ KMBVH_HD KMBVH_INLINE int neighbour_prefix(const unsigned long long* keys, uint3
 }
 
 // One work item per leaf. other_end[] (n - 1 entries) must be kNotYet. visit(node) is
-// called once per inner node, after both children; range_first/last, when set, receive
-// each inner node's range of leaves.
+// called once per inner node, after both children; tree.parent, when set, receives every
+// node's parent, and range_first/last, when set, each inner node's range of leaves.
 template <typename Visit>
 struct BuildRadixTree {
   const unsigned long long* keys;  // sorted
@@ -44,7 +44,7 @@ struct BuildRadixTree {
     uint32_t l = leaf, r = leaf, node = leaf;
     for (;;) {
       if (l == 0 && r == n - 1) {
-        tree.parent[node] = kNoParent;
+        if (tree.parent) tree.parent[node] = kNoParent;
         *root = node;
         return;
       }
@@ -54,15 +54,13 @@ struct BuildRadixTree {
         tree.left[split] = node;
       else
         tree.right[split] = node;
-      tree.parent[node] = n + split;
+      if (tree.parent) tree.parent[node] = n + split;
       const uint32_t other = exchange(&other_end[split], parent_is_right ? l : r);
       if (other == kNotYet) return;  // the sibling is not done yet: it will go on
       (parent_is_right ? r : l) = other;
       node = n + split;
-      if (range_first) {
-        range_first[split] = l;
-        range_last[split] = r;
-      }
+      if (range_first) range_first[split] = l;
+      if (range_last) range_last[split] = r;
       visit(node);
     }
   }

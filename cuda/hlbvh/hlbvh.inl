@@ -54,7 +54,7 @@ inline Bvh build_hlbvh(const PrimitiveSet& prims, const BinaryBuildParams& param
   PhaseClock clock(info);
   MortonRadixTree radix;
   CollapseState state(n);
-  build_morton_radix_tree(prims, radix, state, params, /*with_ranges=*/true, clock);
+  build_morton_radix_tree(prims, radix, state, params, RadixTreeParts{true, true, true}, clock);
   BinaryTreeView tree = radix.view();
 
   // The groups of equal 15-bit prefix, their subtrees' roots, and the inner nodes above them.

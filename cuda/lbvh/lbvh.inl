@@ -15,15 +15,25 @@
 namespace kmbvh {
 namespace KMBVH_BACKEND_NAMESPACE {
 
+// What the radix tree keeps beyond its children and boxes: each node's parent, and each
+// inner node's first and last leaf. HLBVH needs all three and ATRBVH the parents; LBVH only
+// where each range of leaves starts (its leaves refer to them), which keeps 12 bytes a
+// primitive out of its peak memory.
+struct RadixTreeParts {
+  bool parents = true;
+  bool range_first = false;
+  bool range_last = false;
+};
+
 // The radix tree over the Morton order, with boxes, counts, costs and collapse flags of
 // every node. HLBVH and ATRBVH start from it too.
 struct MortonRadixTree {
   uint32_t n = 0;
   Buffer<unsigned long long> codes;
-  Buffer<uint32_t> order, left, right, parent;
-  Buffer<uint32_t> range_first, range_last;  // per inner node, when asked for
+  Buffer<uint32_t> order, left, right, parent;  // parent: when asked for (RadixTreeParts)
+  Buffer<uint32_t> range_first, range_last;     // per inner node, when asked for
   Buffer<Aabb> node_box;
-  uint32_t root = 0;                         // node id, known once the tree is built
+  uint32_t root = 0;                            // node id, known once the tree is built
 
   BinaryTreeView view() {
     BinaryTreeView t;
@@ -31,23 +41,23 @@ struct MortonRadixTree {
     t.root = root;
     t.left = ptr(left);
     t.right = ptr(right);
-    t.parent = ptr(parent);
+    t.parent = parent.empty() ? nullptr : ptr(parent);
     t.box = ptr(node_box);
     t.order = ptr(order);
     return t;
   }
 };
 
-// n >= 2. with_ranges: also keep each inner node's range of leaves (HLBVH needs them).
+// n >= 2.
 inline void build_morton_radix_tree(const PrimitiveSet& prims, MortonRadixTree& t, CollapseState& state,
-                                    const BinaryBuildParams& params, bool with_ranges, PhaseClock& clock) {
+                                    const BinaryBuildParams& params, RadixTreeParts parts, PhaseClock& clock) {
   t.n = static_cast<uint32_t>(prims.size());
   const InputBoxes boxes(prims.boxes);
   morton_order(boxes.data(), t.n, t.codes, t.order);
   clock.lap("morton");
   t.left.resize(t.n - 1);
   t.right.resize(t.n - 1);
-  t.parent.resize(2 * t.n - 1);
+  if (parts.parents) t.parent.resize(2 * t.n - 1);
   t.node_box.resize(2 * t.n - 1);
   Buffer<uint32_t> other_end(t.n - 1), root(1);
   thrust::fill(launch(), other_end.begin(), other_end.end(), kNotYet);
@@ -55,10 +65,12 @@ inline void build_morton_radix_tree(const PrimitiveSet& prims, MortonRadixTree& 
   for_each_index(t.n, InitLeaves{tree, state.view(), params.sah, boxes.data()});
   auto build = build_radix_tree(ptr(t.codes), tree, ptr(other_end), ptr(root),
                                 CollapseNode{tree, state.view(), params.sah, params.max_leaf_size, /*refit=*/true});
-  if (with_ranges) {
+  if (parts.range_first) {
     t.range_first.resize(t.n - 1);
-    t.range_last.resize(t.n - 1);
     build.range_first = ptr(t.range_first);
+  }
+  if (parts.range_last) {
+    t.range_last.resize(t.n - 1);
     build.range_last = ptr(t.range_last);
   }
   for_each_index(t.n, build);
@@ -71,7 +83,7 @@ inline Bvh build_lbvh(const PrimitiveSet& prims, const BinaryBuildParams& params
   PhaseClock clock(info);
   MortonRadixTree tree;
   CollapseState state(uint32_t(prims.size()));
-  build_morton_radix_tree(prims, tree, state, params, /*with_ranges=*/true, clock);
+  build_morton_radix_tree(prims, tree, state, params, RadixTreeParts{/*parents=*/false, /*range_first=*/true}, clock);
   release(tree.codes);
   Bvh bvh = lay_out(tree.view(), state.view(), ptr(tree.range_first));
   clock.lap("layout");
