@@ -33,6 +33,25 @@ struct CountLevel {
   }
 };
 
+// Writes the primitives under `node` (a leaf of the collapsed tree: at most max-leaf-size of
+// them), left to right, from `out` on; returns how many.
+KMBVH_HD KMBVH_INLINE uint32_t gather_leaves(const BinaryTreeView& tree, uint32_t node, uint32_t* out) {
+  uint32_t written = 0;
+  uint32_t stack[64];
+  uint32_t top = 0;
+  stack[top++] = node;
+  while (top > 0) {
+    const uint32_t x = stack[--top];
+    if (tree.is_leaf(x)) {
+      out[written++] = tree.order[x];
+    } else {
+      stack[top++] = tree.right[tree.inner(x)];
+      stack[top++] = tree.left[tree.inner(x)];
+    }
+  }
+  return written;
+}
+
 struct WriteLevel {
   BinaryTreeView tree;
   CollapseView collapse;
@@ -63,22 +82,8 @@ struct WriteLevel {
       nodes[level_base + q] = BvhNode::make_leaf(box, first, collapse.count[node]);
       return;
     }
-    // Gather the leaves under the node, left to right (at most max-leaf-size of them).
     const uint32_t first = prim_base + offsets[q].prims;
-    uint32_t written = 0;
-    uint32_t stack[64];
-    uint32_t top = 0;
-    stack[top++] = node;
-    while (top > 0) {
-      const uint32_t x = stack[--top];
-      if (tree.is_leaf(x)) {
-        prim_indices[first + written++] = tree.order[x];
-      } else {
-        stack[top++] = tree.right[tree.inner(x)];
-        stack[top++] = tree.left[tree.inner(x)];
-      }
-    }
-    nodes[level_base + q] = BvhNode::make_leaf(box, first, written);
+    nodes[level_base + q] = BvhNode::make_leaf(box, first, gather_leaves(tree, node, prim_indices + first));
   }
 };
 

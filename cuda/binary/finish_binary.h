@@ -86,20 +86,8 @@ inline Bvh lay_out(const BinaryTreeView& tree, CollapseView view, const uint32_t
       nodes.push_back(BvhNode::make_leaf(box, first, view.count[node]));
       continue;
     }
-    // The leaves under the node, left to right (at most max-leaf-size of them).
     const uint32_t first = prims;
-    uint32_t stack[64];
-    uint32_t top = 0;
-    stack[top++] = node;
-    while (top > 0) {
-      const uint32_t x = stack[--top];
-      if (tree.is_leaf(x)) {
-        prim_indices[prims++] = tree.order[x];
-      } else {
-        stack[top++] = tree.right[tree.inner(x)];
-        stack[top++] = tree.left[tree.inner(x)];
-      }
-    }
+    prims += gather_leaves(tree, node, prim_indices + first);
     nodes.push_back(BvhNode::make_leaf(box, first, prims - first));
   }
   return bvh;
