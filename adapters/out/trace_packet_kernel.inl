@@ -17,7 +17,8 @@
 
 constexpr unsigned kPacketWidth = 16;
 // Rays entering a subtree at or below which each goes on alone (1, 3, 6 and 10 measured
-// alike within noise on sponza and bunny; 3 reads the fewest nodes among the fast ones).
+// alike within noise on sponza and bunny; 3 reads the fewest nodes among the fast ones;
+// 8 and 14, Embree's switch for incoherent packets, slower on conference's shadow rays).
 constexpr unsigned kSingleRayBelow = 3;
 
 typedef float vfk __attribute__((vector_size(4 * kPacketWidth)));
@@ -110,9 +111,9 @@ inline vfk sheared_component(const PacketShear& r, int j, const float* x, const 
 // gets the masks and t it would get alone; then each ray's candidates are confirmed by
 // confirm_hits, as alone. Calls `found(i, slot, candidate)` for each ray with a
 // candidate. `reach`: each ray's Search::cull.
-template <Query query, Confirm confirm, typename Count, typename Found>
+template <Query query, Confirm confirm, typename PackRayOf, typename Count, typename Found>
 __attribute__((always_inline)) inline void intersect_pack_rays(const TrianglePack& p, const PacketShear& r,
-                                                              const PackRay* pack_rays, const Ray* rays,
+                                                              const PackRayOf& pack_ray, const Ray* rays,
                                                               const TrianglePack* packs, Search* search, vfk reach,
                                                               unsigned active,
                                                               Count& count, const Found& found) {
@@ -145,32 +146,137 @@ __attribute__((always_inline)) inline void intersect_pack_rays(const TrianglePac
     }
     Candidate c;
     const int slot = query == Query::Any
-                         ? confirm_hits<query, confirm>(p, packs, pack_rays[i], rays[i].tnear, search[i], t, h, z, c, count)
-                         : confirm_hits_apart<query, confirm>(p, packs, pack_rays[i], rays[i].tnear, search[i], t, h, z,
+                         ? confirm_hits<query, confirm>(p, packs, pack_ray(i), rays[i].tnear, search[i], t, h, z, c, count)
+                         : confirm_hits_apart<query, confirm>(p, packs, pack_ray(i), rays[i].tnear, search[i], t, h, z,
                                                               c, count);
     if (slot >= 0) found(i, slot, c);
   }
+}
+
+// The packet's rays field by field, lane i holding rays[i]'s (transposed once, so that the
+// set-up below works on 16 rays at a time). A lane not alive holds the first living ray's,
+// so that no lane computes with garbage; the set-up keeps it out of every test.
+struct alignas(64) PacketLanes {
+  float org[3][kPacketWidth], tnear[kPacketWidth], dir[3][kPacketWidth], tfar[kPacketWidth];
+  PacketLanes(const Ray* rays, unsigned alive) {
+    static_assert(sizeof(Ray) == 8 * sizeof(float), "a ray is org, tnear, dir, tfar");
+    const unsigned first = __builtin_ctz(alive | 1);
+    for (unsigned i = 0; i < kPacketWidth; ++i) {
+      float f[8];
+      __builtin_memcpy(f, &rays[alive >> i & 1 ? i : first], sizeof(f));
+      for (int d = 0; d < 3; ++d) org[d][i] = f[d], dir[d][i] = f[4 + d];
+      tnear[i] = f[3], tfar[i] = f[7];
+    }
+  }
+};
+
+inline vfk load_lanes(const float* a) {
+  vfk v;
+  __builtin_memcpy(&v, a, sizeof(v));
+  return v;
+}
+
+inline vfk vsqrt(vfk v) {
+  if constexpr (kAvx512) {
+    return vfk(_mm512_sqrt_ps(__m512(v)));
+  } else {
+    vfk r;
+    for (unsigned i = 0; i < kPacketWidth; i += 4) {
+      __m128 q;
+      __builtin_memcpy(&q, reinterpret_cast<const float*>(&v) + i, sizeof(q));
+      q = _mm_sqrt_ps(q);
+      __builtin_memcpy(reinterpret_cast<float*>(&r) + i, &q, sizeof(q));
+    }
+    return r;
+  }
+}
+
+inline float sum_lanes(vfk v) {
+  const vf8 a = __builtin_shufflevector(v, v, 0, 1, 2, 3, 4, 5, 6, 7) +
+                __builtin_shufflevector(v, v, 8, 9, 10, 11, 12, 13, 14, 15);
+  const vf4 b = __builtin_shufflevector(a, a, 0, 1, 2, 3) + __builtin_shufflevector(a, a, 4, 5, 6, 7);
+  return (b[0] + b[1]) + (b[2] + b[3]);
 }
 
 // Whether the rays of `alive` point within kCoherentCos of their mean direction. Rays that
 // do not (diffuse bounces) would split at the first nodes and only pay for the packet's
 // set-up: each is traced alone instead.
 constexpr float kCoherentCos = 0.8f;  // about 37 degrees (measured: diffuse bounces fall back, camera and shadow rays stay)
-inline bool coherent(const Ray* rays, unsigned alive) {
-  float unit[kPacketWidth][3], mean[3] = {0.0f, 0.0f, 0.0f};
-  for (unsigned b = alive; b; b &= b - 1) {
-    const unsigned i = __builtin_ctz(b);
-    const Vec3 d = rays[i].dir;
-    const float inv = 1.0f / std::sqrt(d.x * d.x + d.y * d.y + d.z * d.z);
-    unit[i][0] = d.x * inv, unit[i][1] = d.y * inv, unit[i][2] = d.z * inv;
-    for (int a = 0; a < 3; ++a) mean[a] += unit[i][a];
+inline bool coherent(const float (&dir)[3][kPacketWidth], unsigned alive) {
+  const vik on = lanes_of(alive);
+  vfk unit[3], mean[3];
+  const vfk d[3] = {load_lanes(dir[0]), load_lanes(dir[1]), load_lanes(dir[2])};
+  const vfk inv = splatk(1.0f) / vsqrt(d[0] * d[0] + d[1] * d[1] + d[2] * d[2]);
+  float m[3];
+  for (int a = 0; a < 3; ++a) unit[a] = d[a] * inv, m[a] = sum_lanes(select(on, unit[a], splatk(0.0f)));
+  for (int a = 0; a < 3; ++a) mean[a] = splatk(m[a]);
+  const float length = std::sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
+  const vik apart = unit[0] * mean[0] + unit[1] * mean[1] + unit[2] * mean[2] < splatk(kCoherentCos * length);
+  return !(mask_bits(apart) & alive);
+}
+
+// What RaySetup finds for each ray of a packet, kept lane by lane, so that a ray going on
+// alone (or tested alone) starts from its lane's values instead of redoing the divisions.
+struct alignas(64) PacketSetup {
+  float inv[4][kPacketWidth];  // RaySetup::inv
+  int k[3][kPacketWidth];      // RaySetup::kx, ky, kz
+  RaySetup of(unsigned i) const {
+    return RaySetup(inv[0][i], inv[1][i], inv[2][i], inv[3][i], k[0][i], k[1][i], k[2][i]);
   }
-  const float length = std::sqrt(mean[0] * mean[0] + mean[1] * mean[1] + mean[2] * mean[2]);
-  for (unsigned b = alive; b; b &= b - 1) {
-    const unsigned i = __builtin_ctz(b);
-    if (unit[i][0] * mean[0] + unit[i][1] * mean[1] + unit[i][2] * mean[2] < kCoherentCos * length) return false;
+};
+
+// a where mask is set, b elsewhere, for masks.
+inline vik pick(vik mask, vik a, vik b) { return (a & mask) | (b & ~mask); }
+// Component a of v where is0 (a = 0) or is1 (a = 1) is set, else component 2.
+inline vfk component(const vfk (&v)[3], vik is0, vik is1) { return select(is0, v[0], select(is1, v[1], v[2])); }
+
+// The slab test's and the pack test's constants of all the packet's rays at once, in
+// RaySetup's and RayShear's operations lane by lane (IEEE division and multiplication give
+// every lane the bits the scalar code gives its ray): the axes, the safe reciprocals, the
+// shear. Returns each ray's initial reach (tfar; -inf for a lane not alive, with tnear
+// +inf, so that it never enters a box).
+inline vfk set_up_packet(const PacketLanes& lanes, unsigned alive, PacketRays& pr, PacketShear& shear,
+                         PacketSetup& setup) {
+  constexpr float kInf = std::numeric_limits<float>::infinity();
+  const vik on = lanes_of(alive);
+  vfk o[3], d[3], a[3];
+  const vik magnitude = vik{} + 0x7FFFFFFF;
+  for (int i = 0; i < 3; ++i) {
+    o[i] = load_lanes(lanes.org[i]), d[i] = load_lanes(lanes.dir[i]);
+    a[i] = vfk(vik(d[i]) & magnitude);
   }
-  return true;
+  // kz: the axis of the largest magnitude (RaySetup's comparisons); kx and ky the next two
+  // in turn, swapped where dir[kz] is negative.
+  const vik x_over_y = a[0] > a[1], x_over_z = a[0] > a[2], y_over_z = a[1] > a[2];
+  const vik z0 = x_over_y & x_over_z, z1 = ~x_over_y & y_over_z;
+  const vfk dz = component(d, z0, z1);
+  const vik swap = dz < splatk(0.0f);
+  const vik z2 = ~(z0 | z1);
+  const vik x0 = pick(swap, z1, z2), x1 = pick(swap, z2, z0);
+  const vik y0 = pick(swap, z2, z1), y1 = pick(swap, z0, z2);
+  const vfk sz = splatk(1.0f) / dz;
+  shear.sz = sz;
+  shear.sx = component(d, x0, x1) * sz;
+  shear.sy = component(d, y0, y1) * sz;
+  shear.org[0] = component(o, x0, x1), shear.org[1] = component(o, y0, y1), shear.org[2] = component(o, z0, z1);
+  shear.axis[0][0] = x0, shear.axis[0][1] = x1;
+  shear.axis[1][0] = y0, shear.axis[1][1] = y1;
+  shear.axis[2][0] = z0, shear.axis[2][1] = z1;
+  const vfk tnear = load_lanes(lanes.tnear);
+  shear.tnear = tnear;
+  pr.tnear = select(on, tnear, splatk(kInf));
+  const vfk tiny = splatk(1e-30f);
+  for (int i = 0; i < 3; ++i) {
+    const vfk safe = select(a[i] < tiny, select(d[i] < splatk(0.0f), -tiny, tiny), d[i]);
+    const vfk inv = splatk(1.0f) / safe;
+    pr.org[i] = o[i], pr.inv[i] = inv, pr.near_hi[i] = inv < splatk(0.0f);
+    __builtin_memcpy(setup.inv[i], &inv, sizeof(inv));
+  }
+  __builtin_memcpy(setup.inv[3], &sz, sizeof(sz));
+  const vik one = vik{} + 1, two = vik{} + 2;
+  const vik k[3] = {(x1 & one) | (~(x0 | x1) & two), (y1 & one) | (~(y0 | y1) & two), (z1 & one) | (z2 & two)};
+  for (int j = 0; j < 3; ++j) __builtin_memcpy(setup.k[j], &k[j], sizeof(k[j]));
+  return select(on, load_lanes(lanes.tfar), splatk(-kInf));
 }
 
 // The rays of `valid` (bit i: rays[i]) into hits; the others' hits are left as they are.
@@ -185,77 +291,37 @@ void traverse_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Hit
     hits[i] = Hit();
     if (!bvh.nodes.empty() && ray_can_hit(rays[i])) alive |= 1u << i;
   }
-  if (!coherent(rays, alive)) {
+  PacketLanes lanes(rays, alive);
+  if (!coherent(lanes.dir, alive)) {
     for (unsigned b = valid; b; b &= b - 1) {
       const unsigned i = __builtin_ctz(b);
       traverse<W, query, false, Count>(bvh, rays[i], single, hits[i], nullptr, Count{}, counted);
     }
     return;
   }
-  // Per-ray set-up: the pack test's and the search's, and the slab test's lanes (a lane
-  // not alive is given a box test it never passes: tnear above tmax).
-  alignas(64) unsigned char pack_storage[kPacketWidth * sizeof(PackRay)];
-  PackRay* pack_rays = reinterpret_cast<PackRay*>(pack_storage);
-  Search search[kPacketWidth];
-  // Lane by lane into plain arrays first, then each array into its vector at once (lane
-  // inserts into vector registers cost several instructions each).
-  struct alignas(64) Lanes16 {
-    float org[3][kPacketWidth], inv[3][kPacketWidth], tnear[kPacketWidth], cull[kPacketWidth];
-    float shear_org[3][kPacketWidth], sx[kPacketWidth], sy[kPacketWidth], sz[kPacketWidth], shear_tnear[kPacketWidth];
-    int near_hi[3][kPacketWidth], axis[3][2][kPacketWidth];
-  } lanes{};
-  for (unsigned i = 0; i < kPacketWidth; ++i) {
-    const bool on = alive >> i & 1;
-    const Ray& ray = rays[on ? i : __builtin_ctz(alive | 1)];
-    const RaySetup setup(ray);
-    for (int d = 0; d < 3; ++d) {
-      lanes.org[d][i] = ray.org[d];
-      lanes.inv[d][i] = setup.inv[d];
-      lanes.near_hi[d][i] = setup.inv[d] < 0.0f ? -1 : 0;
-    }
-    lanes.tnear[i] = on ? ray.tnear : std::numeric_limits<float>::infinity();
-    lanes.cull[i] = on ? ray.tfar : -std::numeric_limits<float>::infinity();
-    search[i] = Search(ray.tfar);
-    if (!on) continue;
-    const PackRay& pack_ray = *new (&pack_rays[i]) PackRay(ray, setup);
-    const RayShear& sh = pack_ray.shear;
-    const int k[3] = {sh.kx, sh.ky, sh.kz};
-    for (int j = 0; j < 3; ++j) {
-      lanes.shear_org[j][i] = ray.org[k[j]];
-      lanes.axis[j][0][i] = k[j] == 0 ? -1 : 0;
-      lanes.axis[j][1][i] = k[j] == 1 ? -1 : 0;
-    }
-    lanes.sx[i] = sh.sx, lanes.sy[i] = sh.sy, lanes.sz[i] = sh.sz;
-    lanes.shear_tnear[i] = ray.tnear;
-  }
-  auto vf = [](const float* a) {
-    vfk v;
-    __builtin_memcpy(&v, a, sizeof(v));
-    return v;
-  };
-  auto vi = [](const int* a) {
-    vik v;
-    __builtin_memcpy(&v, a, sizeof(v));
-    return v;
-  };
   PacketRays pr;
   PacketShear shear;
-  for (int d = 0; d < 3; ++d) {
-    pr.org[d] = vf(lanes.org[d]), pr.inv[d] = vf(lanes.inv[d]), pr.near_hi[d] = vi(lanes.near_hi[d]);
-    shear.org[d] = vf(lanes.shear_org[d]);
-    shear.axis[d][0] = vi(lanes.axis[d][0]), shear.axis[d][1] = vi(lanes.axis[d][1]);
-  }
-  pr.tnear = vf(lanes.tnear);
-  shear.sx = vf(lanes.sx), shear.sy = vf(lanes.sy), shear.sz = vf(lanes.sz), shear.tnear = vf(lanes.shear_tnear);
-  vfk cull = vf(lanes.cull);  // each ray's Search::cull (-inf: not searching)
+  PacketSetup setup;
+  vfk cull = set_up_packet(lanes, alive, pr, shear, setup);  // each ray's Search::cull (-inf: not searching)
+  Search search[kPacketWidth];
+  for (unsigned i = 0; i < kPacketWidth; ++i) search[i] = Search(lanes.tfar[i]);
+  // The single-ray pack test's constants, made for a ray when it first needs them (most
+  // rays of an occlusion packet are answered by the packet's own leaf tests, which need
+  // none but the ray's shear).
+  alignas(64) unsigned char pack_storage[kPacketWidth * sizeof(PackRay)];
+  PackRay* pack_rays = reinterpret_cast<PackRay*>(pack_storage);
+  unsigned packed = 0;
+  auto pack_ray = [&](unsigned i) __attribute__((always_inline)) -> const PackRay& {
+    if (!(packed >> i & 1)) new (&pack_rays[i]) PackRay(rays[i], setup.of(i)), packed |= 1u << i;
+    return pack_rays[i];
+  };
   if (!alive) return;
   // The nearest candidate's hit for the rays that answer closest-hit queries, or the
   // occluder for the occlusion rays that found one.
   unsigned answered = 0;
   auto alone = [&](unsigned i, WideEntry from) {
-    const RaySetup setup(rays[i]);
-    const WideRay<W> wray(rays[i], setup);
-    if (descend<W, query, false, confirm>(bvh, rays[i], wray, pack_rays[i], from, single, search[i], hits[i], nullptr,
+    const WideRay<W> wray(rays[i], setup.of(i));
+    if (descend<W, query, false, confirm>(bvh, rays[i], wray, pack_ray(i), from, single, search[i], hits[i], nullptr,
                                           count))
       alive &= ~(1u << i), answered |= 1u << i, cull[i] = -std::numeric_limits<float>::infinity();
     else
@@ -316,7 +382,7 @@ void traverse_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Hit
         const uint32_t triangles = std::min<uint32_t>(kPackWidth, cur.count - (p - cur.ref) * kPackWidth);
         for (unsigned b = in; b; b &= b - 1) count.pack(triangles);
         if (unsigned(__builtin_popcount(in)) >= kRaysForPacketLeaf) {
-          intersect_pack_rays<query, confirm>(pack, shear, pack_rays, rays, bvh.packs.data(), search, cull, in, count,
+          intersect_pack_rays<query, confirm>(pack, shear, pack_ray, rays, bvh.packs.data(), search, cull, in, count,
                                               take);
           continue;
         }
@@ -324,7 +390,7 @@ void traverse_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Hit
           const unsigned i = __builtin_ctz(b);
           Candidate c;
           const int slot =
-              intersect_pack<query, confirm>(pack, bvh.packs.data(), pack_rays[i], rays[i].tnear, search[i], c, count);
+              intersect_pack<query, confirm>(pack, bvh.packs.data(), pack_ray(i), rays[i].tnear, search[i], c, count);
           if (slot >= 0) take(i, slot, c);
         }
       }
