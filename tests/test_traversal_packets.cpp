@@ -5,7 +5,9 @@
 // on coherent rays it reads fewer nodes, which is its point.
 #include <gtest/gtest.h>
 
+#include <cmath>
 #include <cstring>
+#include <random>
 #include <string>
 
 #include "adapters/builder_registry.h"
@@ -100,6 +102,29 @@ TEST(PacketTraversal, EveryStressCaseSameAsSingleRays) {
     if (rays.size() > c.max_rays) rays.resize(c.max_rays);
     expect_packets_match(c.scene, rays, name, {"sweep-sah", "Q2"});
   }
+}
+
+// Coherent packets whose rays disagree on their shear axes: narrow cones about the
+// diagonals, where each ray's largest direction component (kz) and its sign's swap of kx
+// and ky fall either way, so the packet's leaf test picks each lane's axes by masks
+// (PacketShear::axis); camera rays above mostly share them.
+TEST(PacketTraversal, RaysOfMixedAxesSameAsSingleRays) {
+  const TriangleScene scene = test::random_triangles(3000, 45);
+  std::mt19937 draw(46);
+  std::uniform_real_distribution<float> jitter(-0.02f, 0.02f);
+  std::vector<Ray> rays;
+  for (int x = -1; x <= 1; ++x)
+    for (int y = -1; y <= 1; ++y)
+      for (int z = -1; z <= 1; ++z) {
+        if (std::abs(x) + std::abs(y) + std::abs(z) < 2) continue;  // the diagonals of faces and of the cube
+        for (int i = 0; i < 4 * int(kMaxPacket); ++i) {
+          Ray r;
+          r.org = Vec3(50.0f + jitter(draw), 50.0f + jitter(draw), 50.0f + jitter(draw));
+          r.dir = Vec3(float(x) + jitter(draw), float(y) + jitter(draw), float(z) + jitter(draw));
+          rays.push_back(r);
+        }
+      }
+  expect_packets_match(scene, rays, "mixed axes");
 }
 
 // A partial packet (rtcIntersect16 with some lanes off) answers its valid lanes only.

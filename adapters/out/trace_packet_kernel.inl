@@ -178,7 +178,7 @@ inline vfk load_lanes(const float* a) {
 
 inline vfk vsqrt(vfk v) {
   if constexpr (kAvx512) {
-    return vfk(_mm512_sqrt_ps(__m512(v)));
+    return vfk(_mm512_maskz_sqrt_ps(__mmask16(0xFFFF), __m512(v)));  // the unmasked form warns in GCC 12 (its undefined source)
   } else {
     vfk r;
     for (unsigned i = 0; i < kPacketWidth; i += 4) {
