@@ -185,7 +185,7 @@ TEST(PacketTraversal, CoherentRaysReadFewerNodes) {
   const TraversalCounters single = *tracer.count(sets.primary, Query::Closest);
   EXPECT_EQ(packets.rays, single.rays);
   EXPECT_LT(packets.nodes * 3, single.nodes) << "packet node reads " << packets.nodes << ", single " << single.nodes;
-  std::printf("primary rays, nodes read per ray: single %.2f, packets of 16 %.2f; packs %.2f vs %.2f\n",
+  std::printf("primary rays, nodes read per ray: single %.2f, in packets %.2f; packs %.2f vs %.2f\n",
               double(single.nodes) / single.rays, double(packets.nodes) / packets.rays,
               double(single.packs) / single.rays, double(packets.packs) / packets.rays);
 }

@@ -1,6 +1,10 @@
-// The wide traversal for packets of up to 16 rays (Embree's rtcIntersect16 and its kin):
+// The wide traversal for packets of rays (Embree's rtcIntersect4/8/16 and their kin):
 // included by trace_wide.cpp after trace_wide_kernel.inl, once per instruction set, in the
-// same namespace and target region (16 lanes are one register with AVX-512, two with AVX2).
+// same namespace and target region. A packet is as wide as the region's registers (16 rays
+// with AVX-512, 8 with AVX2, 4 with SSE4.2, as Embree's native packet widths), and a
+// caller's 16 rays go down as that many packets: GCC lowers a vector wider than the
+// target's registers lane by lane where it compares or selects, which made the 16-lane
+// kernel of the AVX2 region 3.5 times slower than its rays traced one at a time.
 //
 // The rays go down the tree together while they are many (Embree's hybrid traversal): a
 // node's boxes are read once for all of them and each child is tested against every ray
@@ -15,11 +19,12 @@
 // confirmation. An occlusion query answers the same yes or no; which occluder it names may
 // differ.
 
-constexpr unsigned kPacketWidth = 16;
-// Rays entering a subtree at or below which each goes on alone (1, 3, 6 and 10 measured
-// alike within noise on sponza and bunny; 3 reads the fewest nodes among the fast ones;
-// 8 and 14, Embree's switch for incoherent packets, slower on conference's shadow rays).
-constexpr unsigned kSingleRayBelow = 3;
+constexpr unsigned kPacketWidth = kAvx512 ? 16 : kAvx ? 8 : 4;
+// Rays entering a subtree at or below which each goes on alone (16 lanes: 1, 3, 6 and 10
+// measured alike within noise on sponza and bunny; 3 reads the fewest nodes among the fast
+// ones; 8 and 14, Embree's switch for incoherent packets, slower on conference's shadow
+// rays). Narrower packets keep the same share of their rays.
+constexpr unsigned kSingleRayBelow = kPacketWidth == 16 ? 3 : 1;
 
 typedef float vfk __attribute__((vector_size(4 * kPacketWidth)));
 typedef int vik __attribute__((vector_size(4 * kPacketWidth)));
@@ -27,24 +32,49 @@ typedef int vik __attribute__((vector_size(4 * kPacketWidth)));
 // aligned to 16 bytes, not 64, and an aligned load from it faults.
 typedef float vfk_unaligned __attribute__((vector_size(4 * kPacketWidth), aligned(4)));
 
-// One bit per lane: one instruction with AVX-512 (a template, so that the other regions
-// never compile it), two halves of eight otherwise.
-template <bool kAvx512Region = kAvx512>
-inline unsigned mask_bits(vik m) {
-  if constexpr (kAvx512Region) return _mm512_movepi32_mask(__m512i(m));
-  vi8 lo, hi;
-  __builtin_memcpy(&lo, &m, sizeof(lo));
-  __builtin_memcpy(&hi, reinterpret_cast<const char*>(&m) + sizeof(lo), sizeof(hi));
-  return mask_bits(lo) | mask_bits(hi) << 8;
+// One bit per lane: one instruction with AVX-512; narrower packets are vi8 or vi4, which
+// mask_bits above takes. (Templates here and below, so that a region compiles only the
+// branch of its own width.)
+template <typename V = vik>
+inline unsigned packet_mask_bits(V m) {
+  if constexpr (sizeof(V) == 64) {
+    return _mm512_movepi32_mask(__m512i(m));
+  } else {
+    return mask_bits(m);
+  }
 }
 
-inline vfk splatk(float x) { return vfk{x, x, x, x, x, x, x, x, x, x, x, x, x, x, x, x}; }
+// x in every lane: one broadcast. (Not `vfk{} + x`, which is an addition GCC must keep:
+// it turns -0 into +0, and it lengthened the node test's chain by 15% on sponza.)
+template <size_t... I>
+inline vfk splat_lanes(float x, std::index_sequence<I...>) {
+  return vfk{((void)I, x)...};
+}
+inline vfk splatk(float x) { return splat_lanes(x, std::make_index_sequence<kPacketWidth>{}); }
 
 // Bit i of `bits` as lane i of a mask.
-inline vik lanes_of(unsigned bits) {
-  const vik bit{1 << 0, 1 << 1, 1 << 2,  1 << 3,  1 << 4,  1 << 5,  1 << 6,  1 << 7,
-                1 << 8, 1 << 9, 1 << 10, 1 << 11, 1 << 12, 1 << 13, 1 << 14, 1 << 15};
+template <size_t... I>
+inline vik lanes_of(unsigned bits, std::index_sequence<I...>) {
+  const vik bit{(1 << I)...};
   return (bit & int(bits)) != 0;
+}
+inline vik lanes_of(unsigned bits) { return lanes_of(bits, std::make_index_sequence<kPacketWidth>{}); }
+
+// The lanes of v folded by `op` (min, +) in halves, to one value.
+template <typename V, typename Op>
+inline float fold_lanes(V v, Op op) {
+  vf4 q;
+  if constexpr (sizeof(V) == 64) {
+    const vf8 a = op(__builtin_shufflevector(v, v, 0, 1, 2, 3, 4, 5, 6, 7),
+                     __builtin_shufflevector(v, v, 8, 9, 10, 11, 12, 13, 14, 15));
+    q = op(__builtin_shufflevector(a, a, 0, 1, 2, 3), __builtin_shufflevector(a, a, 4, 5, 6, 7));
+  } else if constexpr (sizeof(V) == 32) {
+    q = op(__builtin_shufflevector(v, v, 0, 1, 2, 3), __builtin_shufflevector(v, v, 4, 5, 6, 7));
+  } else {
+    q = v;
+  }
+  const vf4 h = op(q, __builtin_shufflevector(q, q, 2, 3, 0, 1));
+  return op(h, __builtin_shufflevector(h, h, 1, 0, 3, 2))[0];
 }
 
 // a where mask is set, b elsewhere.
@@ -53,11 +83,14 @@ inline vfk select(vik mask, vfk a, vfk b) { return vfk((vik(a) & mask) | (vik(b)
 // The slab test's per-ray constants, one lane a ray, the same values as WideRay's.
 struct PacketRays {
   vfk org[3], inv[3], tnear;
-  vik near_hi[3];  // lanes whose direction is negative on the axis: the box's hi plane is met first
 };
 
-// Which rays of `active` enter child `c` of `n`, and where: the single-ray slab test's
-// operations in the same order, so each ray enters what it would enter alone.
+// Which rays of `active` enter child `c` of `n`, and where: each ray's plane distances as
+// the single-ray slab test measures them, so each ray enters what it would enter alone.
+// The near plane is the nearer of the two, not chosen by the direction's sign: the same
+// value (a box's lo <= hi, the rounding is monotonic, and no operand is NaN: the
+// reciprocals are finite), in one vminps/vmaxps a plane where a select by the sign
+// took a compare and two masked moves (Embree's packet node test has the same form).
 template <int W>
 __attribute__((always_inline)) inline vik enter_child(const WideNode<W>& n, int c, const PacketRays& r, vfk tmax,
                                                       vik active, vfk& entry) {
@@ -65,8 +98,8 @@ __attribute__((always_inline)) inline vik enter_child(const WideNode<W>& n, int 
   for (int d = 0; d < 3; ++d) {
     const vfk lo = (splatk(n.lo[d][c]) - r.org[d]) * r.inv[d];
     const vfk hi = (splatk(n.hi[d][c]) - r.org[d]) * r.inv[d];
-    t0 = vmax(t0, select(r.near_hi[d], hi, lo));
-    t1 = vmin(t1, select(r.near_hi[d], lo, hi));
+    t0 = vmax(t0, vmin(lo, hi));
+    t1 = vmin(t1, vmax(lo, hi));
   }
   entry = t0;
   return (t0 <= t1 * kRobustExit) & active;
@@ -83,15 +116,12 @@ struct PacketEntry {
 // where its nearest ray goes first).
 inline float nearest_entry(vfk entry, vik rays) {
   const vfk v = select(rays, entry, splatk(std::numeric_limits<float>::infinity()));
-  const vf8 a = vmin(__builtin_shufflevector(v, v, 0, 1, 2, 3, 4, 5, 6, 7),
-                     __builtin_shufflevector(v, v, 8, 9, 10, 11, 12, 13, 14, 15));
-  const vf4 b = vmin(__builtin_shufflevector(a, a, 0, 1, 2, 3), __builtin_shufflevector(a, a, 4, 5, 6, 7));
-  return std::min(std::min(b[0], b[1]), std::min(b[2], b[3]));
+  return fold_lanes(v, [](auto a, auto b) { return vmin(a, b); });
 }
 
 // Rays in a leaf from which its packs are tested SIMD over the rays (below: each ray
 // tests the pack SIMD over its triangles, as alone).
-constexpr unsigned kRaysForPacketLeaf = 6;
+constexpr unsigned kRaysForPacketLeaf = kPacketWidth == 16 ? 6 : kPacketWidth == 8 ? 3 : 2;
 
 // The pack test's per-ray constants (PackRay), one lane a ray, and each ray's axes.
 struct PacketShear {
@@ -130,8 +160,8 @@ __attribute__((always_inline)) inline void intersect_pack_rays(const TrianglePac
       y[v] = dy - r.sy * z[v];
     }
     const WatertightLanes<vfk, vik> w = watertight_lanes<vfk, vik>(x, y, z, r.sz, r.tnear, reach);
-    hits[slot] = mask_bits(w.valid & ~w.exact_zero & on);
-    redo[slot] = mask_bits(w.exact_zero & on);
+    hits[slot] = packet_mask_bits(w.valid & ~w.exact_zero & on);
+    redo[slot] = packet_mask_bits(w.exact_zero & on);
     any |= hits[slot] | redo[slot];
     if (hits[slot] | redo[slot]) ts[slot] = w.T / w.det;
   }
@@ -176,11 +206,12 @@ inline vfk load_lanes(const float* a) {
   return v;
 }
 
-inline vfk vsqrt(vfk v) {
-  if constexpr (kAvx512) {
-    return vfk(_mm512_maskz_sqrt_ps(__mmask16(0xFFFF), __m512(v)));  // the unmasked form warns in GCC 12 (its undefined source)
+template <typename V = vfk>
+inline V vsqrt(V v) {
+  if constexpr (sizeof(V) == 64) {
+    return V(_mm512_maskz_sqrt_ps(__mmask16(0xFFFF), __m512(v)));  // the unmasked form warns in GCC 12 (its undefined source)
   } else {
-    vfk r;
+    V r;
     for (unsigned i = 0; i < kPacketWidth; i += 4) {
       __m128 q;
       __builtin_memcpy(&q, reinterpret_cast<const float*>(&v) + i, sizeof(q));
@@ -192,10 +223,7 @@ inline vfk vsqrt(vfk v) {
 }
 
 inline float sum_lanes(vfk v) {
-  const vf8 a = __builtin_shufflevector(v, v, 0, 1, 2, 3, 4, 5, 6, 7) +
-                __builtin_shufflevector(v, v, 8, 9, 10, 11, 12, 13, 14, 15);
-  const vf4 b = __builtin_shufflevector(a, a, 0, 1, 2, 3) + __builtin_shufflevector(a, a, 4, 5, 6, 7);
-  return (b[0] + b[1]) + (b[2] + b[3]);
+  return fold_lanes(v, [](auto a, auto b) { return a + b; });
 }
 
 // Whether the rays of `alive` point within kCoherentCos of their mean direction. Rays that
@@ -212,7 +240,7 @@ inline bool coherent(const float (&dir)[3][kPacketWidth], unsigned alive) {
   for (int a = 0; a < 3; ++a) mean[a] = splatk(m[a]);
   const float length = std::sqrt(m[0] * m[0] + m[1] * m[1] + m[2] * m[2]);
   const vik apart = unit[0] * mean[0] + unit[1] * mean[1] + unit[2] * mean[2] < splatk(kCoherentCos * length);
-  return !(mask_bits(apart) & alive);
+  return !(packet_mask_bits(apart) & alive);
 }
 
 // What RaySetup finds for each ray of a packet, kept lane by lane, so that a ray going on
@@ -269,7 +297,7 @@ inline vfk set_up_packet(const PacketLanes& lanes, unsigned alive, PacketRays& p
   for (int i = 0; i < 3; ++i) {
     const vfk safe = select(a[i] < tiny, select(d[i] < splatk(0.0f), -tiny, tiny), d[i]);
     const vfk inv = splatk(1.0f) / safe;
-    pr.org[i] = o[i], pr.inv[i] = inv, pr.near_hi[i] = inv < splatk(0.0f);
+    pr.org[i] = o[i], pr.inv[i] = inv;
     __builtin_memcpy(setup.inv[i], &inv, sizeof(inv));
   }
   __builtin_memcpy(setup.inv[3], &sz, sizeof(sz));
@@ -349,7 +377,7 @@ void traverse_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Hit
         const int c = __builtin_ctz(lanes);
         vfk entry;
         const vik in = enter_child(n, c, pr, cull, active, entry);
-        const unsigned rays_in = mask_bits(in);
+        const unsigned rays_in = packet_mask_bits(in);
         if (!rays_in) continue;
         entered[m] = PacketEntry{entry, n.ref[c], n.count[c], rays_in};
         prefetch_child(bvh, n.ref[c], n.count[c]);
@@ -399,7 +427,7 @@ void traverse_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Hit
     do {
       if (sp == 0) goto done;
       cur = stack[--sp];
-      cur.rays &= alive & mask_bits(cur.entry <= cull * kRobustExit);  // as the single-ray descent's pop
+      cur.rays &= alive & packet_mask_bits(cur.entry <= cull * kRobustExit);  // as the single-ray descent's pop
     } while (!cur.rays);
   }
 done:
@@ -418,33 +446,41 @@ done:
 
 // This instruction set's packet entry points (trace_wide.cpp dispatches to them).
 
-// One packet: bit i of `valid` traces rays[i] into hits[i]; counted into `counters` when
-// it is not null. The stacks are the calling thread's, kept from packet to packet.
+// Up to 16 rays: bit i of `valid` traces rays[i] into hits[i], kPacketWidth rays a packet;
+// counted into `counters` when it is not null. The stacks are the calling thread's, kept
+// from packet to packet.
 template <int W>
 void trace_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Query query, Hit* hits,
                   TraversalCounters* counters) {
   thread_local std::vector<PacketEntry> stack;
   thread_local std::vector<WideEntry> single;
   if (stack.size() < bvh.stack_size) stack.resize(bvh.stack_size), single.resize(bvh.stack_size);
-  if (!counters) {
-    if (query == Query::Any)
-      traverse_packet<W, Query::Any>(bvh, rays, valid, hits, stack.data(), single.data(), NoTally{}, nullptr);
-    else
-      traverse_packet<W, Query::Closest>(bvh, rays, valid, hits, stack.data(), single.data(), NoTally{}, nullptr);
-  } else if (query == Query::Any) {
-    traverse_packet<W, Query::Any>(bvh, rays, valid, hits, stack.data(), single.data(), Tally{}, counters);
-  } else {
-    traverse_packet<W, Query::Closest>(bvh, rays, valid, hits, stack.data(), single.data(), Tally{}, counters);
+  constexpr unsigned kLanes = (1u << kPacketWidth) - 1u;
+  for (unsigned first = 0; valid >> first; first += kPacketWidth) {
+    const unsigned lanes = valid >> first & kLanes;
+    if (!lanes) continue;
+    const Ray* r = rays + first;
+    Hit* h = hits + first;
+    if (!counters) {
+      if (query == Query::Any)
+        traverse_packet<W, Query::Any>(bvh, r, lanes, h, stack.data(), single.data(), NoTally{}, nullptr);
+      else
+        traverse_packet<W, Query::Closest>(bvh, r, lanes, h, stack.data(), single.data(), NoTally{}, nullptr);
+    } else if (query == Query::Any) {
+      traverse_packet<W, Query::Any>(bvh, r, lanes, h, stack.data(), single.data(), Tally{}, counters);
+    } else {
+      traverse_packet<W, Query::Closest>(bvh, r, lanes, h, stack.data(), single.data(), Tally{}, counters);
+    }
   }
 }
 
-// rays[0, n) cut into packets of kPacketWidth consecutive rays.
+// rays[0, n) cut into groups of 16 consecutive rays, as rtcIntersect16 takes them (each
+// traced as packets of kPacketWidth).
 template <int W>
 void trace_packets(const WideBvh<W>& bvh, const Ray* rays, size_t n, Query query, Hit* hits,
                    TraversalCounters* counters) {
-  for (size_t first = 0; first < n; first += kPacketWidth) {
-    const size_t size = std::min<size_t>(kPacketWidth, n - first);
-    const unsigned valid = size == kPacketWidth ? 0xFFFFu : (1u << size) - 1u;
-    trace_packet(bvh, rays + first, valid, query, hits + first, counters);
+  for (size_t first = 0; first < n; first += kMaxPacket) {
+    const size_t size = std::min<size_t>(kMaxPacket, n - first);
+    trace_packet(bvh, rays + first, (1u << size) - 1u, query, hits + first, counters);
   }
 }

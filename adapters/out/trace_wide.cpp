@@ -8,6 +8,7 @@
 #include <limits>
 #include <new>
 #include <type_traits>
+#include <utility>
 
 #include "cuda/core/parallel_errors.h"
 #include "cuda/traversal/ray_box.h"
