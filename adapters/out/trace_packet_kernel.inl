@@ -373,7 +373,7 @@ void traverse_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Hit
       int order[W];  // entered children, farthest first (for occlusion: as met)
       int m = 0;
       // Lanes holding a child: an empty lane's box is inverted (wide_bvh.h).
-      for (unsigned lanes = mask_bits(load<W>(n.lo[0]) <= load<W>(n.hi[0])); lanes; lanes &= lanes - 1) {
+      for (unsigned lanes = less_equal_bits(load<W>(n.lo[0]), load<W>(n.hi[0])); lanes; lanes &= lanes - 1) {
         const int c = __builtin_ctz(lanes);
         vfk entry;
         const vik in = enter_child(n, c, pr, cull, active, entry);

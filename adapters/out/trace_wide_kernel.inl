@@ -29,13 +29,30 @@ struct Lanes<8> {
 using vfp = Lanes<kPackWidth>::V;  // a pack's lanes
 using vip = std::conditional_t<kPackWidth == 8, vi8, vi4>;
 
+// Halves of an 8-lane vector. The SSE4.2 region's registers hold four lanes, and GCC
+// lowers an 8-lane min, max or comparison there lane by lane (maxss, comiss, spills),
+// where two 4-lane instructions do.
+inline vf4 low_half(vf8 v) { return __builtin_shufflevector(v, v, 0, 1, 2, 3); }
+inline vf4 high_half(vf8 v) { return __builtin_shufflevector(v, v, 4, 5, 6, 7); }
+inline vf8 join_halves(vf4 lo, vf4 hi) { return __builtin_shufflevector(lo, hi, 0, 1, 2, 3, 4, 5, 6, 7); }
+template <typename V>
+constexpr bool kSplitLanes = !kAvx && sizeof(V) == 32;
+
 template <typename V>
 inline V vmin(V a, V b) {
-  return b < a ? b : a;
+  if constexpr (kSplitLanes<V>) {
+    return join_halves(vmin(low_half(a), low_half(b)), vmin(high_half(a), high_half(b)));
+  } else {
+    return b < a ? b : a;
+  }
 }
 template <typename V>
 inline V vmax(V a, V b) {
-  return a < b ? b : a;
+  if constexpr (kSplitLanes<V>) {
+    return join_halves(vmax(low_half(a), low_half(b)), vmax(high_half(a), high_half(b)));
+  } else {
+    return a < b ? b : a;
+  }
 }
 
 // One bit per lane of a comparison's result. (The ISA macros such as __AVX__ describe the
@@ -49,6 +66,16 @@ inline unsigned mask_bits(vi8 m) {
     __builtin_memcpy(&lo, &m, sizeof(lo));
     __builtin_memcpy(&hi, reinterpret_cast<const char*>(&m) + sizeof(lo), sizeof(hi));
     return mask_bits(lo) | mask_bits(hi) << 4;
+  }
+}
+
+// One bit per lane where a <= b.
+inline unsigned less_equal_bits(vf4 a, vf4 b) { return mask_bits(a <= b); }
+inline unsigned less_equal_bits(vf8 a, vf8 b) {
+  if constexpr (kAvx) {
+    return mask_bits(a <= b);
+  } else {
+    return less_equal_bits(low_half(a), low_half(b)) | less_equal_bits(high_half(a), high_half(b)) << 4;
   }
 }
 
@@ -134,7 +161,7 @@ inline unsigned enter_children(const WideNode<W>& n, const WideRay<W>& r, float 
     t1 = vmin(t1, (load<W>(planes + r.far_plane[d]) - r.org[d]) * r.inv_exit[d]);
   }
   entry = t0;
-  return mask_bits(t0 <= t1);
+  return less_equal_bits(t0, t1);
 }
 
 // Starts fetching the first two lines of what a child entered or pushed will read (an
