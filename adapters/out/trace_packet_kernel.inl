@@ -184,7 +184,7 @@ __attribute__((always_inline)) inline void intersect_pack_rays(const TrianglePac
 }
 
 // The packet's rays field by field, lane i holding rays[i]'s (transposed once, so that the
-// set-up below works on 16 rays at a time). A lane not alive holds the first living ray's,
+// set-up below works on the packet's rays at once). A lane not alive holds the first living ray's,
 // so that no lane computes with garbage; the set-up keeps it out of every test.
 struct alignas(64) PacketLanes {
   float org[3][kPacketWidth], tnear[kPacketWidth], dir[3][kPacketWidth], tfar[kPacketWidth];

@@ -122,7 +122,7 @@ struct RaySetup {
     const __m128 safe = select4(small, select4(_mm_cmplt_ps(d, _mm_setzero_ps()), _mm_set1_ps(-1e-30f), tiny), d);
     _mm_storeu_ps(inv, _mm_div_ps(_mm_set1_ps(1.0f), safe));
   }
-  // The same, found elsewhere (the packet traversal's set-up, 16 rays at a time).
+  // The same, found elsewhere (the packet traversal's set-up, a packet's rays at a time).
   RaySetup(float inv_x, float inv_y, float inv_z, float inv_dir_kz, int x, int y, int z)
       : inv{inv_x, inv_y, inv_z, inv_dir_kz}, kx(x), ky(y), kz(z) {}
 };
