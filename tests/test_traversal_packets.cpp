@@ -7,6 +7,7 @@
 
 #include <cmath>
 #include <cstring>
+#include <limits>
 #include <random>
 #include <string>
 
@@ -153,6 +154,56 @@ TEST(PacketTraversal, InvalidLanesAreNotTouched) {
   std::vector<Hit> hits(kMaxPacket, untouched);
   bvh2.trace_packet(rays.data(), 0x00FFu, Query::Closest, hits.data());
   for (unsigned i = 0; i < kMaxPacket; ++i) EXPECT_EQ(hits[i].primID, i < 8 ? single[i].primID : 12345u) << i;
+}
+
+// Rays that cannot hit anything (ray_can_hit: a NaN or infinite origin or direction, a
+// negative or NaN tnear, a NaN tfar, an empty interval, a zero direction) among living rays
+// of a packet, first lane or not, one or all of them: they miss, and the others answer as
+// alone (the packet's validity test is lane by lane, and their lanes are refilled). The
+// negative tnear is put where it would reach a triangle: on a hit, the interval around it.
+TEST(PacketTraversal, RaysThatCannotHitMissAmongTheOthers) {
+  const TriangleScene scene = test::random_triangles(20000, 45);
+  const PrimitiveSet prims = make_primitive_set(scene);
+  const Bvh bvh = run_builder(test::config_from_spec("Q2"), prims);
+  const Tracer tracer(bvh, prims, scene, Layout::Bvh8);
+  std::vector<Ray> rays = camera_rays(scene, 1200);
+  std::vector<Hit> before;
+  tracer.trace(rays, Query::Closest, before);
+  const float nan = std::numeric_limits<float>::quiet_NaN(), inf = std::numeric_limits<float>::infinity();
+  const auto spoil = [&](size_t r, unsigned how) {
+    Ray& ray = rays[r];
+    switch (how % 8) {
+      case 0: ray.org.y = nan; break;
+      case 1: ray.dir.z = inf; break;
+      case 2:
+        if (before[r].found()) ray.org = ray.org + ray.dir * before[r].t, ray.tnear = -0.5f * before[r].t;
+        else ray.tnear = -1.0f;
+        break;
+      case 3: ray.tfar = nan; break;
+      case 4: ray.tnear = ray.tfar * 2.0f + 1.0f; break;
+      case 5: ray.dir = Vec3(0.0f, 0.0f, 0.0f); break;
+      case 6: ray.org.x = -inf; break;
+      default: ray.tnear = nan; break;
+    }
+  };
+  for (size_t first = 0; first + kMaxPacket <= rays.size(); first += kMaxPacket) {
+    const unsigned packet = unsigned(first / kMaxPacket);
+    if (packet % 5 == 4) {  // every ray of the packet
+      for (unsigned i = 0; i < kMaxPacket; ++i) spoil(first + i, packet + i);
+      continue;
+    }
+    for (unsigned i = packet % 3; i < kMaxPacket; i += 3 + packet % 4) spoil(first + i, i == 0 ? 2 : packet * 7 + i);
+  }
+  expect_packets_match(scene, rays, "rays that cannot hit", {"sweep-sah", "Q2"});
+  for (const Query query : {Query::Closest, Query::Any}) {
+    std::vector<Hit> hits;
+    tracer.trace_packets(rays, query, hits);
+    for (size_t r = 0; r < rays.size(); ++r) {
+      if (!ray_can_hit(rays[r])) {
+        ASSERT_FALSE(hits[r].found()) << "ray " << r;
+      }
+    }
+  }
 }
 
 // Deeper than any stack sized by hand: the packet and single-ray stacks follow the tree.

@@ -112,11 +112,126 @@ struct PacketEntry {
   unsigned rays;
 };
 
+// The same without the distances, for occlusion packets: their rays' intervals do not
+// shrink until they are answered (and an answered ray leaves the packet), so neither the
+// order of the children nor the cull on a pop needs them. 12 bytes where an entry has 76.
+struct PacketRef {
+  uint32_t ref, count;
+  unsigned rays;
+};
+
+// A thread's stacks, kept from packet to packet, each of a tree's stack_size entries.
+struct PacketStacks {
+  std::vector<PacketEntry> entries;  // closest-hit packets
+  std::vector<PacketRef> refs;       // occlusion packets
+  std::vector<WideEntry> single;     // rays going on alone
+  void reserve(uint32_t size) {
+    if (entries.size() < size) entries.resize(size), refs.resize(size), single.resize(size);
+  }
+};
+
 // The nearest entry among the rays `rays` (for ordering children: the packet goes first
 // where its nearest ray goes first).
 inline float nearest_entry(vfk entry, vik rays) {
   const vfk v = select(rays, entry, splatk(std::numeric_limits<float>::infinity()));
   return fold_lanes(v, [](auto a, auto b) { return vmin(a, b); });
+}
+
+// The packet's rays field by field, lane i holding rays[i]'s (transposed once, so that the
+// set-up below works on the packet's rays at once). Only the rays of `valid` are read; a lane
+// not in it holds the first valid ray's. Lanes whose rays cannot hit are then given a living
+// ray's (`replace`), so that no lane computes with garbage; the set-up keeps them out of every test.
+struct alignas(64) PacketLanes {
+  float org[3][kPacketWidth], tnear[kPacketWidth], dir[3][kPacketWidth], tfar[kPacketWidth];
+  PacketLanes(const Ray* rays, unsigned valid) {
+    static_assert(sizeof(Ray) == 8 * sizeof(float), "a ray is org, tnear, dir, tfar");
+    const unsigned first = __builtin_ctz(valid | 1);
+    for (unsigned i = 0; i < kPacketWidth; ++i) {
+      float f[8];
+      __builtin_memcpy(f, &rays[valid >> i & 1 ? i : first], sizeof(f));
+      for (int d = 0; d < 3; ++d) org[d][i] = f[d], dir[d][i] = f[4 + d];
+      tnear[i] = f[3], tfar[i] = f[7];
+    }
+  }
+  // The lanes of `dead` take lane `from`'s ray (rare: out of line).
+  __attribute__((noinline, cold)) void replace(unsigned dead, unsigned from) {
+    for (; dead; dead &= dead - 1) {
+      const unsigned i = __builtin_ctz(dead);
+      for (int d = 0; d < 3; ++d) org[d][i] = org[d][from], dir[d][i] = dir[d][from];
+      tnear[i] = tnear[from], tfar[i] = tfar[from];
+    }
+  }
+};
+
+inline vfk load_lanes(const float* a) {
+  vfk v;
+  __builtin_memcpy(&v, a, sizeof(v));
+  return v;
+}
+
+// ray_can_hit (ray.h) of every lane's ray, one bit a lane, in the same comparisons (a float
+// is finite where its exponent is not all ones, as std::isfinite has it).
+inline unsigned can_hit_lanes(const PacketLanes& l) {
+  const vik exponent = vik{} + 0x7F800000;
+  vik ok = ~vik{};
+  for (int d = 0; d < 3; ++d) {
+    vfk o = load_lanes(l.org[d]), v = load_lanes(l.dir[d]);
+    ok &= ((vik(o) & exponent) != exponent) & ((vik(v) & exponent) != exponent);
+  }
+  const vfk zero = splatk(0.0f), tnear = load_lanes(l.tnear), tfar = load_lanes(l.tfar);
+  const vfk dx = load_lanes(l.dir[0]), dy = load_lanes(l.dir[1]), dz = load_lanes(l.dir[2]);
+  ok &= (tnear >= zero) & (tfar == tfar) & (tnear <= tfar) & ~((dx == zero) & (dy == zero) & (dz == zero));
+  return packet_mask_bits(ok);
+}
+
+// Half a packet's lanes in double precision, one register of the region (8 lanes with
+// AVX-512, 4 with AVX2, 2 with SSE4.2).
+constexpr unsigned kHalfPacket = kPacketWidth / 2;
+typedef double vdh __attribute__((vector_size(8 * kHalfPacket)));
+typedef long long vlh __attribute__((vector_size(8 * kHalfPacket)));
+typedef float vfh __attribute__((vector_size(4 * kHalfPacket)));
+
+template <typename V = vlh>  // (a template, so that a region compiles only its own width's branch)
+inline unsigned half_mask_bits(V m) {
+  if constexpr (sizeof(V) == 64) {
+    return _mm512_movepi64_mask(__m512i(m));
+  } else if constexpr (sizeof(V) == 32) {
+    return unsigned(_mm256_movemask_pd(__m256d(m)));
+  } else {
+    return unsigned(_mm_movemask_pd(__m128d(m)));
+  }
+}
+
+// Lanes [h * kHalfPacket, (h + 1) * kHalfPacket) of a packet's field, in double.
+inline vdh half_lanes(const float* a, unsigned h) {
+  vfh v;
+  __builtin_memcpy(&v, a + h * kHalfPacket, sizeof(v));
+  return __builtin_convertvector(v, vdh);
+}
+
+// exact_within (watertight.h) of triangle (a, b, c) for every ray of the packet, one
+// bit a ray, over each ray's whole interval (tnear, tfar]: the interval an occlusion ray
+// accepts its first candidate in. The same operations in the same order lane by lane
+// (IEEE double, no contraction), so each bit is what the scalar function answers.
+inline unsigned exact_within_lanes(const PacketLanes& lanes, Vec3 a, Vec3 b, Vec3 c) {
+  const ExactEdges e(a, b, c);
+  const vlh sign_bit = vlh{} + (1ll << 63);
+  unsigned bits = 0;
+  for (unsigned h = 0; h < 2; ++h) {
+    const vdh dx = half_lanes(lanes.dir[0], h), dy = half_lanes(lanes.dir[1], h), dz = half_lanes(lanes.dir[2], h);
+    const vdh px = dy * e.e2z - dz * e.e2y, py = dz * e.e2x - dx * e.e2z, pz = dx * e.e2y - dy * e.e2x;
+    const vdh det = e.e1x * px + e.e1y * py + e.e1z * pz;
+    const vdh sx = half_lanes(lanes.org[0], h) - double(a.x), sy = half_lanes(lanes.org[1], h) - double(a.y),
+              sz = half_lanes(lanes.org[2], h) - double(a.z);
+    const vdh qx = sy * e.e1z - sz * e.e1y, qy = sz * e.e1x - sx * e.e1z, qz = sx * e.e1y - sy * e.e1x;
+    const vdh T = e.e2x * qx + e.e2y * qy + e.e2z * qz;
+    const vlh sign = vlh(det) & sign_bit;  // the scalar code's negation of both where det < 0
+    const vdh abs_det = vdh(vlh(det) ^ sign), signed_T = vdh(vlh(T) ^ sign);
+    const vlh within = (det == 0.0) | ((signed_T > half_lanes(lanes.tnear, h) * abs_det) &
+                                       (signed_T <= half_lanes(lanes.tfar, h) * abs_det));
+    bits |= half_mask_bits(within) << (h * kHalfPacket);
+  }
+  return bits;
 }
 
 // Rays in a leaf from which its packs are tested SIMD over the rays (below: each ray
@@ -143,9 +258,9 @@ inline vfk sheared_component(const PacketShear& r, int j, const float* x, const 
 // candidate. `reach`: each ray's Search::cull.
 template <Query query, Confirm confirm, typename PackRayOf, typename Count, typename Found>
 __attribute__((always_inline)) inline void intersect_pack_rays(const TrianglePack& p, const PacketShear& r,
-                                                              const PackRayOf& pack_ray, const Ray* rays,
-                                                              const TrianglePack* packs, Search* search, vfk reach,
-                                                              unsigned active,
+                                                              const PacketLanes& lanes, const PackRayOf& pack_ray,
+                                                              const Ray* rays, const TrianglePack* packs,
+                                                              Search* search, vfk reach, unsigned active,
                                                               Count& count, const Found& found) {
   const vik on = lanes_of(active);
   unsigned hits[kPackWidth], redo[kPackWidth], any = 0;
@@ -165,6 +280,38 @@ __attribute__((always_inline)) inline void intersect_pack_rays(const TrianglePac
     any |= hits[slot] | redo[slot];
     if (hits[slot] | redo[slot]) ts[slot] = w.T / w.det;
   }
+  if constexpr (query == Query::Any) {
+    // What confirm_hits does for each ray of an occlusion query (whose first confirmed
+    // candidate answers it, measured over its whole interval): the slots it hits in slot
+    // order, the first that exact_within confirms taken; here the rays of a slot measured
+    // at once. A ray none of them answers tries the slots left to the scalar test.
+    unsigned open = any;
+    for (int slot = 0; slot < kPackWidth && open; ++slot) {
+      const unsigned tested = hits[slot] & open;
+      if (!tested) continue;
+      for (unsigned b = tested; b; b &= b - 1) count.exact();
+      const unsigned passed =
+          tested & exact_within_lanes(lanes, slot_vertex(p, 0, slot), slot_vertex(p, 1, slot), slot_vertex(p, 2, slot));
+      for (unsigned b = passed; b; b &= b - 1) {
+        const unsigned i = __builtin_ctz(b);
+        Candidate c;
+        c.t = ts[slot][i];
+        found(i, slot, c);
+      }
+      open &= ~passed;
+    }
+    for (; open; open &= open - 1) {
+      const unsigned i = __builtin_ctz(open);
+      unsigned z = 0;
+      for (int slot = 0; slot < kPackWidth; ++slot) z |= (redo[slot] >> i & 1) << slot;
+      if (!z) continue;
+      Candidate c;
+      const int slot =
+          confirm_hits<query, confirm>(p, packs, pack_ray(i), rays[i].tnear, search[i], vfp{}, 0, z, c, count);
+      if (slot >= 0) found(i, slot, c);
+    }
+    return;
+  }
   for (; any; any &= any - 1) {
     const unsigned i = __builtin_ctz(any);
     unsigned h = 0, z = 0;
@@ -175,35 +322,10 @@ __attribute__((always_inline)) inline void intersect_pack_rays(const TrianglePac
       if ((hits[slot] | redo[slot]) >> i & 1) t[slot] = ts[slot][i];
     }
     Candidate c;
-    const int slot = query == Query::Any
-                         ? confirm_hits<query, confirm>(p, packs, pack_ray(i), rays[i].tnear, search[i], t, h, z, c, count)
-                         : confirm_hits_apart<query, confirm>(p, packs, pack_ray(i), rays[i].tnear, search[i], t, h, z,
-                                                              c, count);
+    const int slot =
+        confirm_hits_apart<query, confirm>(p, packs, pack_ray(i), rays[i].tnear, search[i], t, h, z, c, count);
     if (slot >= 0) found(i, slot, c);
   }
-}
-
-// The packet's rays field by field, lane i holding rays[i]'s (transposed once, so that the
-// set-up below works on the packet's rays at once). A lane not alive holds the first living ray's,
-// so that no lane computes with garbage; the set-up keeps it out of every test.
-struct alignas(64) PacketLanes {
-  float org[3][kPacketWidth], tnear[kPacketWidth], dir[3][kPacketWidth], tfar[kPacketWidth];
-  PacketLanes(const Ray* rays, unsigned alive) {
-    static_assert(sizeof(Ray) == 8 * sizeof(float), "a ray is org, tnear, dir, tfar");
-    const unsigned first = __builtin_ctz(alive | 1);
-    for (unsigned i = 0; i < kPacketWidth; ++i) {
-      float f[8];
-      __builtin_memcpy(f, &rays[alive >> i & 1 ? i : first], sizeof(f));
-      for (int d = 0; d < 3; ++d) org[d][i] = f[d], dir[d][i] = f[4 + d];
-      tnear[i] = f[3], tfar[i] = f[7];
-    }
-  }
-};
-
-inline vfk load_lanes(const float* a) {
-  vfk v;
-  __builtin_memcpy(&v, a, sizeof(v));
-  return v;
 }
 
 template <typename V = vfk>
@@ -308,18 +430,19 @@ inline vfk set_up_packet(const PacketLanes& lanes, unsigned alive, PacketRays& p
 }
 
 // The rays of `valid` (bit i: rays[i]) into hits; the others' hits are left as they are.
-// `stack` holds bvh.stack_size packet entries, `single` bvh.stack_size single-ray ones.
+// `stacks` hold bvh.stack_size entries each.
 template <int W, Query query, typename Count>
-void traverse_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Hit* hits, PacketEntry* stack,
-                     WideEntry* single, Count count, TraversalCounters* counted) {
+void traverse_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Hit* hits, PacketStacks& stacks,
+                     Count count, TraversalCounters* counted) {
+  PacketEntry* const stack = stacks.entries.data();
+  PacketRef* const refs = stacks.refs.data();
+  WideEntry* const single = stacks.single.data();
   constexpr Confirm confirm = query == Query::Any ? Confirm::Interval : Confirm::Deferred;
-  unsigned alive = 0;  // rays still searching
-  for (unsigned b = valid; b; b &= b - 1) {
-    const unsigned i = __builtin_ctz(b);
-    hits[i] = Hit();
-    if (!bvh.nodes.empty() && ray_can_hit(rays[i])) alive |= 1u << i;
-  }
-  PacketLanes lanes(rays, alive);
+  for (unsigned b = valid; b; b &= b - 1) hits[__builtin_ctz(b)] = Hit();
+  PacketLanes lanes(rays, valid);
+  unsigned alive = bvh.nodes.empty() ? 0 : valid & can_hit_lanes(lanes);  // rays still searching
+  constexpr unsigned kAllLanes = (1u << kPacketWidth) - 1u;
+  if (alive && alive != kAllLanes) lanes.replace(kAllLanes & ~alive, __builtin_ctz(alive));
   if (!coherent(lanes.dir, alive)) {
     for (unsigned b = valid; b; b &= b - 1) {
       const unsigned i = __builtin_ctz(b);
@@ -361,35 +484,55 @@ void traverse_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Hit
     if (unsigned(__builtin_popcount(cur.rays)) <= kSingleRayBelow) {
       for (unsigned b = cur.rays; b; b &= b - 1) {
         const unsigned i = __builtin_ctz(b);
-        alone(i, WideEntry{cur.ref, cur.count, cur.entry[i]});
+        // (An occlusion packet keeps no distances; the descent does not read its first entry's.)
+        alone(i, WideEntry{cur.ref, cur.count, query == Query::Any ? 0.0f : cur.entry[i]});
       }
     } else if (cur.count == 0) {
       const WideNode<W>& n = bvh.nodes[cur.ref];
       count.node();
       _mm_prefetch(reinterpret_cast<const char*>(n.ref), _MM_HINT_T0);
       const vik active = lanes_of(cur.rays);
-      PacketEntry entered[W];
-      float nearest[W];
-      int order[W];  // entered children, farthest first (for occlusion: as met)
-      int m = 0;
-      // Lanes holding a child: an empty lane's box is inverted (wide_bvh.h).
-      for (unsigned lanes = less_equal_bits(load<W>(n.lo[0]), load<W>(n.hi[0])); lanes; lanes &= lanes - 1) {
-        const int c = __builtin_ctz(lanes);
-        vfk entry;
-        const vik in = enter_child(n, c, pr, cull, active, entry);
-        const unsigned rays_in = packet_mask_bits(in);
-        if (!rays_in) continue;
-        entered[m] = PacketEntry{entry, n.ref[c], n.count[c], rays_in};
-        prefetch_child(bvh, n.ref[c], n.count[c]);
-        nearest[m] = query == Query::Any ? 0.0f : nearest_entry(entry, in);
-        int at = m;
-        for (; at > 0 && nearest[order[at - 1]] < nearest[m]; --at) order[at] = order[at - 1];
-        order[at] = m++;
-      }
-      if (m > 0) {
-        for (int i = 0; i < m - 1; ++i) stack[sp++] = entered[order[i]];
-        cur = entered[order[m - 1]];
-        continue;
+      if constexpr (query == Query::Any) {
+        // Any hit will do: the children entered are pushed as met and the last is taken
+        // next (Embree's order for occlusion packets).
+        const uint32_t below = sp;
+        // Lanes holding a child: an empty lane's box is inverted (wide_bvh.h).
+        for (unsigned lanes = less_equal_bits(load<W>(n.lo[0]), load<W>(n.hi[0])); lanes; lanes &= lanes - 1) {
+          const int c = __builtin_ctz(lanes);
+          vfk entry;
+          const unsigned rays_in = packet_mask_bits(enter_child(n, c, pr, cull, active, entry));
+          if (!rays_in) continue;
+          refs[sp++] = PacketRef{n.ref[c], n.count[c], rays_in};
+          prefetch_child(bvh, n.ref[c], n.count[c]);
+        }
+        if (sp > below) {
+          const PacketRef next = refs[--sp];
+          cur.ref = next.ref, cur.count = next.count, cur.rays = next.rays;
+          continue;
+        }
+      } else {
+        PacketEntry entered[W];
+        float nearest[W];
+        int order[W];  // entered children, farthest first
+        int m = 0;
+        for (unsigned lanes = less_equal_bits(load<W>(n.lo[0]), load<W>(n.hi[0])); lanes; lanes &= lanes - 1) {
+          const int c = __builtin_ctz(lanes);
+          vfk entry;
+          const vik in = enter_child(n, c, pr, cull, active, entry);
+          const unsigned rays_in = packet_mask_bits(in);
+          if (!rays_in) continue;
+          entered[m] = PacketEntry{entry, n.ref[c], n.count[c], rays_in};
+          prefetch_child(bvh, n.ref[c], n.count[c]);
+          nearest[m] = nearest_entry(entry, in);
+          int at = m;
+          for (; at > 0 && nearest[order[at - 1]] < nearest[m]; --at) order[at] = order[at - 1];
+          order[at] = m++;
+        }
+        if (m > 0) {
+          for (int i = 0; i < m - 1; ++i) stack[sp++] = entered[order[i]];
+          cur = entered[order[m - 1]];
+          continue;
+        }
       }
     } else {
       for (uint32_t p = cur.ref, end = cur.ref + (cur.count + kPackWidth - 1) / kPackWidth; p < end; ++p) {
@@ -410,8 +553,8 @@ void traverse_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Hit
         const uint32_t triangles = std::min<uint32_t>(kPackWidth, cur.count - (p - cur.ref) * kPackWidth);
         for (unsigned b = in; b; b &= b - 1) count.pack(triangles);
         if (unsigned(__builtin_popcount(in)) >= kRaysForPacketLeaf) {
-          intersect_pack_rays<query, confirm>(pack, shear, pack_ray, rays, bvh.packs.data(), search, cull, in, count,
-                                              take);
+          intersect_pack_rays<query, confirm>(pack, shear, lanes, pack_ray, rays, bvh.packs.data(), search, cull, in,
+                                              count, take);
           continue;
         }
         for (unsigned b = in; b; b &= b - 1) {
@@ -426,8 +569,13 @@ void traverse_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Hit
     // The next subtree some living ray still enters within its interval.
     do {
       if (sp == 0) goto done;
-      cur = stack[--sp];
-      cur.rays &= alive & packet_mask_bits(cur.entry <= cull * kRobustExit);  // as the single-ray descent's pop
+      if constexpr (query == Query::Any) {
+        const PacketRef next = refs[--sp];
+        cur.ref = next.ref, cur.count = next.count, cur.rays = next.rays & alive;
+      } else {
+        cur = stack[--sp];
+        cur.rays &= alive & packet_mask_bits(cur.entry <= cull * kRobustExit);  // as the single-ray descent's pop
+      }
     } while (!cur.rays);
   }
 done:
@@ -452,9 +600,8 @@ done:
 template <int W>
 void trace_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Query query, Hit* hits,
                   TraversalCounters* counters) {
-  thread_local std::vector<PacketEntry> stack;
-  thread_local std::vector<WideEntry> single;
-  if (stack.size() < bvh.stack_size) stack.resize(bvh.stack_size), single.resize(bvh.stack_size);
+  thread_local PacketStacks stacks;
+  stacks.reserve(bvh.stack_size);
   constexpr unsigned kLanes = (1u << kPacketWidth) - 1u;
   for (unsigned first = 0; valid >> first; first += kPacketWidth) {
     const unsigned lanes = valid >> first & kLanes;
@@ -463,13 +610,13 @@ void trace_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Query 
     Hit* h = hits + first;
     if (!counters) {
       if (query == Query::Any)
-        traverse_packet<W, Query::Any>(bvh, r, lanes, h, stack.data(), single.data(), NoTally{}, nullptr);
+        traverse_packet<W, Query::Any>(bvh, r, lanes, h, stacks, NoTally{}, nullptr);
       else
-        traverse_packet<W, Query::Closest>(bvh, r, lanes, h, stack.data(), single.data(), NoTally{}, nullptr);
+        traverse_packet<W, Query::Closest>(bvh, r, lanes, h, stacks, NoTally{}, nullptr);
     } else if (query == Query::Any) {
-      traverse_packet<W, Query::Any>(bvh, r, lanes, h, stack.data(), single.data(), Tally{}, counters);
+      traverse_packet<W, Query::Any>(bvh, r, lanes, h, stacks, Tally{}, counters);
     } else {
-      traverse_packet<W, Query::Closest>(bvh, r, lanes, h, stack.data(), single.data(), Tally{}, counters);
+      traverse_packet<W, Query::Closest>(bvh, r, lanes, h, stacks, Tally{}, counters);
     }
   }
 }
