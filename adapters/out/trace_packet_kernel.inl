@@ -20,6 +20,7 @@
 // differ.
 
 constexpr unsigned kPacketWidth = kAvx512 ? 16 : kAvx ? 8 : 4;
+constexpr unsigned kPacketLanes = (1u << kPacketWidth) - 1u;  // a bit for each of a packet's lanes
 // Rays entering a subtree at or below which each goes on alone (16 lanes: 1, 3, 6 and 10
 // measured alike within noise on sponza and bunny; 3 reads the fewest nodes among the fast
 // ones; 8 and 14, Embree's switch for incoherent packets, slower on conference's shadow
@@ -173,14 +174,14 @@ inline vfk load_lanes(const float* a) {
 // is finite where its exponent is not all ones, as std::isfinite has it).
 inline unsigned can_hit_lanes(const PacketLanes& l) {
   const vik exponent = vik{} + 0x7F800000;
-  vik ok = ~vik{};
-  for (int d = 0; d < 3; ++d) {
-    vfk o = load_lanes(l.org[d]), v = load_lanes(l.dir[d]);
-    ok &= ((vik(o) & exponent) != exponent) & ((vik(v) & exponent) != exponent);
-  }
   const vfk zero = splatk(0.0f), tnear = load_lanes(l.tnear), tfar = load_lanes(l.tfar);
-  const vfk dx = load_lanes(l.dir[0]), dy = load_lanes(l.dir[1]), dz = load_lanes(l.dir[2]);
-  ok &= (tnear >= zero) & (tfar == tfar) & (tnear <= tfar) & ~((dx == zero) & (dy == zero) & (dz == zero));
+  vik ok = (tnear >= zero) & (tfar == tfar) & (tnear <= tfar), zero_dir = ~vik{};
+  for (int d = 0; d < 3; ++d) {
+    const vfk o = load_lanes(l.org[d]), v = load_lanes(l.dir[d]);
+    ok &= ((vik(o) & exponent) != exponent) & ((vik(v) & exponent) != exponent);
+    zero_dir &= v == zero;
+  }
+  ok &= ~zero_dir;
   return packet_mask_bits(ok);
 }
 
@@ -441,8 +442,7 @@ void traverse_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Hit
   for (unsigned b = valid; b; b &= b - 1) hits[__builtin_ctz(b)] = Hit();
   PacketLanes lanes(rays, valid);
   unsigned alive = bvh.nodes.empty() ? 0 : valid & can_hit_lanes(lanes);  // rays still searching
-  constexpr unsigned kAllLanes = (1u << kPacketWidth) - 1u;
-  if (alive && alive != kAllLanes) lanes.replace(kAllLanes & ~alive, __builtin_ctz(alive));
+  if (alive && alive != kPacketLanes) lanes.replace(kPacketLanes & ~alive, __builtin_ctz(alive));
   if (!coherent(lanes.dir, alive)) {
     for (unsigned b = valid; b; b &= b - 1) {
       const unsigned i = __builtin_ctz(b);
@@ -515,6 +515,7 @@ void traverse_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Hit
         float nearest[W];
         int order[W];  // entered children, farthest first
         int m = 0;
+        // Lanes holding a child, as above.
         for (unsigned lanes = less_equal_bits(load<W>(n.lo[0]), load<W>(n.hi[0])); lanes; lanes &= lanes - 1) {
           const int c = __builtin_ctz(lanes);
           vfk entry;
@@ -602,9 +603,8 @@ void trace_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Query 
                   TraversalCounters* counters) {
   thread_local PacketStacks stacks;
   stacks.reserve(bvh.stack_size);
-  constexpr unsigned kLanes = (1u << kPacketWidth) - 1u;
   for (unsigned first = 0; valid >> first; first += kPacketWidth) {
-    const unsigned lanes = valid >> first & kLanes;
+    const unsigned lanes = valid >> first & kPacketLanes;
     if (!lanes) continue;
     const Ray* r = rays + first;
     Hit* h = hits + first;
