@@ -3,8 +3,11 @@
 #include <gtest/gtest.h>
 
 #include "adapters/builder_registry.h"
+#include "adapters/in/default_scene.h"
 #include "adapters/in/load_scene.h"
 #include "adapters/in/scene_folder.h"
+#include "adapters/out/tracer.h"
+#include "adapters/rays/scene_rays.h"
 #include "support/rays.h"
 #include "support/scenes.h"
 
@@ -66,6 +69,29 @@ TEST(Rays, ZeroAreaTrianglesAreNeverHit) {
   const Bvh bvh = run_builder(parse_builder("Q2"), prims);
   for (uint32_t r = 0; r < 1000; ++r)
     ASSERT_FALSE(test::closest_hit_bvh(bvh, prims, scene, test::random_ray(scene.bounds(), 5, r)).found());
+}
+
+// The default scene's far outlier box sets its bounds 20 times wider than the rest: views
+// placed by those bounds looked past every triangle, so every primary ray missed and the
+// shadow and diffuse rays all left one or two points.
+TEST(Rays, DefaultSceneViewsLookAtTheScene) {
+  const TriangleScene scene = make_default_scene();
+  EXPECT_GT(scene.bounds().hi.x, 4000.0f);
+  EXPECT_LT(view_bounds(scene).hi.x, 400.0f);
+  const PrimitiveSet prims = make_primitive_set(scene);
+  const RaySets sets = scene_ray_sets(scene, prims, 3000, 7);
+  const Tracer tracer(run_builder(parse_builder("lbvh"), prims), prims, scene, Layout::Bvh2);
+  std::vector<Hit> hits;
+  tracer.trace(sets.primary, Query::Closest, hits);
+  size_t found = 0;
+  for (const Hit& h : hits) found += h.found();
+  EXPECT_GT(found, hits.size() / 4) << "of the 3 views' primary rays (an open scene: the sky takes the rest)";
+}
+
+TEST(Rays, ViewBoundsAreTheBoundsWithoutAnOutlier) {
+  const TriangleScene scene = test::random_triangles(2000, 5);
+  EXPECT_EQ(view_bounds(scene).lo, scene.bounds().lo);
+  EXPECT_EQ(view_bounds(scene).hi, scene.bounds().hi);
 }
 
 }  // namespace

@@ -69,7 +69,8 @@ RaySets make_ray_sets(const TriangleScene& scene, size_t count, uint32_t seed, c
   RaySets sets;
   const Aabb bounds = scene.bounds();
   if (scene.triangles.empty() || bounds.is_empty()) return sets;
-  sets.primary = primary_rays(bounds, count, seed);
+  const Aabb placed = view_bounds(scene);  // cameras and light where the triangles are
+  sets.primary = primary_rays(placed, count, seed);
   std::vector<Hit> hits;
   trace(sets.primary, hits);
 
@@ -91,7 +92,7 @@ RaySets make_ray_sets(const TriangleScene& scene, size_t count, uint32_t seed, c
   }
   if (points.empty()) return sets;
 
-  const Vec3 light = scene_light(bounds);
+  const Vec3 light = scene_light(placed);
   sets.shadow.reserve(count);
   sets.diffuse.reserve(count);
   for (size_t i = 0; i < count; ++i) {

@@ -11,27 +11,6 @@ namespace {
 
 constexpr float kPi = 3.14159265f;
 
-Aabb core_bounds(const PrimitiveSet& prims) {
-  if (prims.empty()) return Aabb(Vec3(-1.0f), Vec3(1.0f));
-  Aabb core;
-  std::vector<float> c(prims.size());
-  for (int axis = 0; axis < 3; ++axis) {
-    for (size_t i = 0; i < prims.size(); ++i) c[i] = prims.boxes[i].center()[axis];
-    const size_t lo = c.size() / 100, hi = c.size() - 1 - c.size() / 100;
-    std::nth_element(c.begin(), c.begin() + lo, c.end());
-    core.lo[axis] = c[lo];
-    std::nth_element(c.begin(), c.begin() + hi, c.end());
-    core.hi[axis] = c[hi];
-  }
-  // A flat core (a single wall, a plane) still needs some depth to look at.
-  const Vec3 e = core.extent();
-  const float widest = std::max(e.x, std::max(e.y, e.z));
-  const float pad = widest > 0.0f ? 0.01f * widest : 1.0f;
-  for (int axis = 0; axis < 3; ++axis)
-    if (core.hi[axis] - core.lo[axis] < pad) core.lo[axis] -= pad, core.hi[axis] += pad;
-  return core;
-}
-
 // Unit directions evenly over the sphere (a Fibonacci lattice).
 std::vector<Vec3> sphere_directions(int n) {
   std::vector<Vec3> dirs;

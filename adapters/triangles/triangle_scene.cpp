@@ -1,5 +1,8 @@
 #include "triangle_scene.h"
 
+#include <algorithm>
+#include <vector>
+
 #include "cuda/core/huge_pages.h"
 
 namespace kmbvh {
@@ -53,6 +56,35 @@ PrimitiveSet make_primitive_set(const TriangleScene& scene, size_t* dropped) {
   }
   if (dropped) *dropped = skipped;
   return set;
+}
+
+Aabb core_bounds(const PrimitiveSet& prims) {
+  if (prims.empty()) return Aabb(Vec3(-1.0f), Vec3(1.0f));
+  Aabb core;
+  std::vector<float> c(prims.size());
+  for (int axis = 0; axis < 3; ++axis) {
+    for (size_t i = 0; i < prims.size(); ++i) c[i] = prims.boxes[i].center()[axis];
+    const size_t lo = c.size() / 100, hi = c.size() - 1 - c.size() / 100;
+    std::nth_element(c.begin(), c.begin() + lo, c.end());
+    core.lo[axis] = c[lo];
+    std::nth_element(c.begin(), c.begin() + hi, c.end());
+    core.hi[axis] = c[hi];
+  }
+  // A flat core (a single wall, a plane) still needs some depth to look at.
+  const Vec3 e = core.extent();
+  const float widest = std::max(e.x, std::max(e.y, e.z));
+  const float pad = widest > 0.0f ? 0.01f * widest : 1.0f;
+  for (int axis = 0; axis < 3; ++axis)
+    if (core.hi[axis] - core.lo[axis] < pad) core.lo[axis] -= pad, core.hi[axis] += pad;
+  return core;
+}
+
+Aabb view_bounds(const TriangleScene& scene) {
+  const Aabb bounds = scene.bounds();
+  const PrimitiveSet prims = make_primitive_set(scene);
+  if (prims.empty()) return bounds;
+  const Aabb core = core_bounds(prims);
+  return length(bounds.extent()) > 2.0f * length(core.extent()) ? core : bounds;
 }
 
 }  // namespace kmbvh

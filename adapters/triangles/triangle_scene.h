@@ -51,4 +51,13 @@ class SceneError : public std::runtime_error {
 // vertex are left out, as Embree's scene commit leaves them out; `dropped` counts them.
 PrimitiveSet make_primitive_set(const TriangleScene& scene, size_t* dropped = nullptr);
 
+// The bounds of the middle 98% of the boxes' centres on each axis (a flat core padded to 1%
+// of its widest side): where the scene is, without the far outliers that its bounds include.
+Aabb core_bounds(const PrimitiveSet& prims);
+
+// The bounds that views and lights are placed by: the scene's bounds, or its core's where
+// the bounds' diagonal is more than twice the core's (a far outlier, as in the default
+// scene, would leave the cameras looking at empty space).
+Aabb view_bounds(const TriangleScene& scene);
+
 }  // namespace kmbvh

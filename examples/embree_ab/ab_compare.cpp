@@ -129,8 +129,9 @@ int main(int argc, char** argv) {
                                     : quality_name == "high" ? RTC_BUILD_QUALITY_HIGH
                                                              : RTC_BUILD_QUALITY_MEDIUM;
     std::vector<Ray> rays;
+    const kmbvh::Aabb placed = kmbvh::view_bounds(scene);
     for (int view = 0; view < kmbvh::kViewsPerScene; ++view) {
-      const kmbvh::Camera camera = kmbvh::scene_view(scene.bounds(), view, float(width) / float(height));
+      const kmbvh::Camera camera = kmbvh::scene_view(placed, view, float(width) / float(height));
       for (unsigned y = 0; y < height; ++y)
         for (unsigned x = 0; x < width; ++x) rays.push_back(camera.ray((x + 0.5f) / width, (y + 0.5f) / height));
     }
