@@ -76,10 +76,14 @@ std::string BuilderConfig::label() const {
   const std::string wide = kmeans.wide ? " wide" : "";
   if (!preset.empty()) return fmt::format("kmeans {}{}{}", preset, medians, wide);
   const std::string adaptive = kmeans.adaptive ? " adaptive" : "";
+  const std::string cells = kmeans.seeding == Seeding::Cells ? " cells" : "";
+  const std::string leaves = std::string(kmeans.sah_leaves ? " sah-leaves" : "") +
+                             (kmeans.restructure_passes > 0 ? " restructured" : "");
   const std::string stable = !kmeans.until_stable         ? ""
                              : kmeans.settle_fraction > 0 ? fmt::format(" until-stable({:g})", kmeans.settle_fraction)
                                                           : " until-stable";
-  return fmt::format("kmeans k={} p={} i={}{}{}{}{}", kmeans.k, kmeans.p, kmeans.i, adaptive, stable, medians, wide);
+  return fmt::format("kmeans k={} p={} i={}{}{}{}{}{}{}", kmeans.k, kmeans.p, kmeans.i, adaptive, cells, stable,
+                     leaves, medians, wide);
 }
 
 BuilderConfig parse_builder(const std::string& spec) {
@@ -95,12 +99,12 @@ BuilderConfig parse_builder(const std::string& spec) {
   const std::optional<BuilderKind> kind = builder_kind(name);
   if (!kind)
     throw std::invalid_argument(fmt::format(
-        "unknown builder '{}' (sweep-sah, lbvh, hlbvh, atrbvh, ploc, kmeans, Q1..Q5, QA, Q1S..Q5S, QAS, Q1R..Q5R, QAR, "
+        "unknown builder '{}' (sweep-sah, lbvh, hlbvh, atrbvh, ploc, kmeans, Q1..Q5, QA, Q1S..Q5S, QAS, Q1R..Q5R, QAR, G before S, R or alone (Q2GS), "
         "embree-low|medium|high)", spec));
   config.builder = *kind;
   if (*kind == BuilderKind::Kmeans) {
     const auto params = kmeans_preset(preset);
-    if (!params) throw std::invalid_argument(fmt::format("unknown k-means preset '{}' (Q1 to Q5, QA, each of them alone or followed by S or R)", preset));
+    if (!params) throw std::invalid_argument(fmt::format("unknown k-means preset '{}' (Q1 to Q5, QA, each of them alone or followed by G, S, R, GS or GR)", preset));
     config.kmeans = *params;
     config.preset = preset;
     for (char& c : config.preset) c = char(std::toupper(static_cast<unsigned char>(c)));
@@ -113,7 +117,7 @@ BuilderConfig parse_builder(const std::string& spec) {
 std::vector<BuilderConfig> all_builders() {
   std::vector<BuilderConfig> all;
   for (const char* spec : {"sweep-sah", "lbvh", "hlbvh", "atrbvh", "ploc", "Q1", "Q2", "Q3", "Q4", "Q5", "QA", "Q1S", "Q3S",
-                           "QAS", "embree-low", "embree-medium", "embree-high"})
+                           "QAS", "Q2GS", "QAGS", "embree-low", "embree-medium", "embree-high"})
     all.push_back(parse_builder(spec));
   return all;
 }

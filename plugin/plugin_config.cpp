@@ -116,7 +116,7 @@ BuilderConfig builder_for(const PluginConfig& config, RTCBuildQuality quality) {
   // MEDIUM take the k-means configuration nearest to dominating Embree's build of that
   // quality on the shared scenes; HIGH, where Embree's rtcBuildBVH builds MEDIUM's tree in
   // MEDIUM's time, the one with the lowest SAH cost, the faster of equals.
-  if (preset.empty()) preset = quality == RTC_BUILD_QUALITY_LOW ? "Q1" : quality == RTC_BUILD_QUALITY_HIGH ? "Q3R" : "Q2S";
+  if (preset.empty()) preset = quality == RTC_BUILD_QUALITY_LOW ? "Q1" : quality == RTC_BUILD_QUALITY_HIGH ? "Q2GR" : "Q1GS";
   BuilderConfig b = parse_builder("kmeans:" + preset);
   if (config.k || config.p || config.i) b.preset.clear();
   if (config.k) b.kmeans.k = config.k;

@@ -54,7 +54,7 @@ PluginConfig read_plugin_config();
 // defaults are used.
 const PluginConfig& plugin_config();
 
-// The builder for one build of the given quality (LOW: Q1, MEDIUM: Q2S, HIGH: Q3R for
+// The builder for one build of the given quality (LOW: Q1, MEDIUM: Q1GS, HIGH: Q2GR for
 // k-means, unless KMBVH_PRESET/K/P/I say otherwise; plugin/README.md has the table).
 BuilderConfig builder_for(const PluginConfig& config, RTCBuildQuality quality);
 

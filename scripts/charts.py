@@ -13,6 +13,8 @@
   scripts/charts.py projection HQ.json OUT.md        # HQ rendered against HQ projected from LQ
   scripts/charts.py iterations ITERS.json OUT_DIR    # SAH cost against Lloyd iterations for each k
   scripts/charts.py phases PHASES.json OUT_DIR       # k-means build time by phase, per preset
+  scripts/charts.py beyond BENCH.json OUT_DIR        # k-means beyond the paper against Embree: the Pareto front
+  scripts/charts.py beyond_table BENCH.json OUT.md   # its targets per scene: on the front, dominating embree-medium
   scripts/charts.py all DIR                          # every chart whose JSON is in DIR (results.sh's names)
 
 Each chart is written as PNG and SVG. STRESS.json is `kmbvh stress --json`; BENCH.json is
@@ -220,7 +222,15 @@ def pareto_front(points):
     return front
 
 
-def pareto_chart(rows, out_dir):
+def kmeans_on_front(rows):
+    """The k-means builders of `rows` (one scene's) on the Pareto front of build time and SAH
+    cost, among the rows that have a cost."""
+    costed = [r for r in rows if r["sah_cost"] is not None]
+    front = [costed[i] for i in pareto_front([(r["build_ms"], r["sah_cost"]) for r in costed])]
+    return [short(r["builder"]) for r in front if r["builder_name"] == "kmeans"]
+
+
+def pareto_chart(rows, out_dir, name="pareto", title="Speed against quality: build time and SAH cost"):
     """Per scene: build time (log) against SAH cost for every builder (Embree end to end has no
     tree to cost), k-means red, the references blue, Embree's builders purple; the Pareto
     front joined by a line."""
@@ -236,10 +246,44 @@ def pareto_chart(rows, out_dir):
         front = sorted((points[i] for i in pareto_front(points)))
         ax.plot([p[0] for p in front], [p[1] for p in front], color="grey", linestyle="--", linewidth=1, zorder=2)
         panel(ax, scene, "build ms (log)", "SAH cost", log_build_ms=True)
-    fig.suptitle("Speed against quality: build time and SAH cost (lower left is better; dashed: the Pareto front; "
-                 "red k-means, blue references, purple Embree)", fontsize=10)
+    fig.suptitle(f"{title} (lower left is better; dashed: the Pareto front; red k-means, blue references, "
+                 "purple Embree)", fontsize=10)
     fig.tight_layout()
-    save(fig, out_dir, "pareto")
+    save(fig, out_dir, name)
+
+
+def beyond_chart(rows, out_dir):
+    pareto_chart(rows, out_dir, "beyond", "k-means beyond the paper against Embree's builders")
+
+
+def beyond_table(rows, out_path):
+    """Per scene (#16's targets): the k-means configurations on the Pareto front of build time
+    and SAH cost, those that dominate embree-medium (less time, SAH no higher), and the
+    cheapest k-means tree built in no more than embree-medium's time."""
+    lines = ["| scene | k-means on the Pareto front | dominating embree-medium | embree-medium ms, SAH | "
+             "cheapest k-means within its time: SAH ratio |",
+             "|---|---|---|---:|---:|"]
+    scenes = ordered(r["scene"] for r in rows)
+    on_front = dominating = 0
+    for scene in scenes:
+        mine = [r for r in rows if r["scene"] == scene]
+        km_front = kmeans_on_front(mine)
+        medium = next((r for r in mine if r["builder"] == "embree-medium"), None)
+        km = [r for r in mine if r["builder_name"] == "kmeans"]
+        dom = [short(r["builder"]) for r in km
+               if medium and r["build_ms"] < medium["build_ms"] and r["sah_cost"] <= medium["sah_cost"]]
+        within = [r for r in km if medium and r["build_ms"] <= medium["build_ms"]]
+        best = min(within, key=lambda r: r["sah_cost"]) if within else None
+        on_front += bool(km_front)
+        dominating += bool(dom)
+        lines.append(f"| {scene.rsplit('.', 1)[0]} | {', '.join(km_front) or 'none'} | {', '.join(dom) or 'none'} | "
+                     + (f"{medium['build_ms']:.1f}, {medium['sah_cost']:.1f}" if medium else "-") + " | "
+                     + (f"{best['sah_cost'] / medium['sah_cost']:.3f} ({short(best['builder'])})" if best else "-")
+                     + " |")
+    lines.append("")
+    lines.append(f"Some k-means configuration on the Pareto front on {on_front} of {len(scenes)} scenes; one dominating "
+                 f"embree-medium on {dominating} of {len(scenes)}.")
+    Path(out_path).write_text("\n".join(lines) + "\n")
 
 
 def speed_chart(rows, out_dir):
@@ -300,9 +344,7 @@ def targets_table(rows, out_path):
     on_front = fastest = 0
     for scene in scenes:
         mine = [r for r in rows if r["scene"] == scene]
-        costed = [r for r in mine if r["sah_cost"] is not None]
-        front = [costed[i] for i in pareto_front([(r["build_ms"], r["sah_cost"]) for r in costed])]
-        kmeans_front = [short(r["builder"]) for r in front if r["builder_name"] == "kmeans"]
+        kmeans_front = kmeans_on_front(mine)
         on_front += bool(kmeans_front)
         timed = [r for r in mine if r["lq"] and r["traversal"] == "kmbvh"]
         km = [r for r in timed if r["builder_name"] == "kmeans"]
@@ -430,7 +472,7 @@ def load(path):
 
 CHARTS = {"stress": stress_chart, "presets": presets_chart, "table": presets_table, "scaling": scaling_chart,
           "pareto": pareto_chart, "speed": speed_chart, "tti": tti_chart, "targets": targets_table, "paper": paper_table,
-          "projection": projection_table,
+          "projection": projection_table, "beyond": beyond_chart, "beyond_table": beyond_table,
           "iterations": iterations_chart, "phases": phases_chart}
 
 # What `all DIR` makes: chart, its JSON in DIR, and where the chart goes (a folder, or a file).
@@ -438,7 +480,7 @@ ALL = [("stress", "stress.json", "."), ("presets", "presets.json", "."), ("table
        ("scaling", "scaling.json", "."), ("pareto", "suite.json", "."), ("speed", "suite.json", "."),
        ("tti", "suite.json", "."), ("targets", "suite.json", "targets.md"), ("paper", "suite.json", "paper.md"),
        ("projection", "hq.json", "projection.md"), ("iterations", "iterations.json", "."),
-       ("phases", "phases.json", ".")]
+       ("phases", "phases.json", "."), ("beyond", "beyond.json", "."), ("beyond_table", "beyond.json", "beyond.md")]
 
 
 def main(argv):

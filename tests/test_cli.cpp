@@ -69,6 +69,7 @@ TEST(Cli, BuildJsonHasEveryField) {
   EXPECT_EQ(j["build_ms_runs"].size(), 3u);
   EXPECT_EQ(j["params"]["k"], 16);
   EXPECT_EQ(j["params"]["metric"], "medians");
+  EXPECT_EQ(j["params"]["seeding"], "farthest");
   EXPECT_TRUE(j["valid"].get<bool>()) << j["validation"];
   EXPECT_GT(j["sah_cost"].get<double>(), 0.0);
 }
@@ -80,6 +81,16 @@ TEST(Cli, BuildWithoutSceneUsesTheDefaultScene) {
   EXPECT_EQ(j["scene"], "default");
   EXPECT_GE(j["triangles"].get<int>(), 200000);
   EXPECT_TRUE(j["valid"].get<bool>());
+}
+
+TEST(Cli, CellSeedingByPresetOrOption) {
+  for (const char* args : {"--preset q2gs", "--builder Q2GS", "--preset Q2S --seeding cells"}) {
+    const Result r = run("build " + small_obj().string() + " " + args + " --runs 1 --warmup 0 --json -q");
+    ASSERT_EQ(r.exit_code, 0) << args << ": " << r.err;
+    const auto j = nlohmann::json::parse(r.out);
+    EXPECT_EQ(j["params"]["seeding"], "cells") << args;
+    EXPECT_TRUE(j["valid"].get<bool>()) << args;
+  }
 }
 
 TEST(Cli, EmbreeBuilderAndTable) {
@@ -113,7 +124,7 @@ TEST(Cli, UnreadableFileExitsWithTwoAndNamesIt) {
 }
 
 TEST(Cli, BadArgumentsExitWithTwo) {
-  for (const char* args : {"build --builder nonsense", "build --k 1", "build --preset Q9", "build --builder lbvh --m 33",
+  for (const char* args : {"build --builder nonsense", "build --k 1", "build --preset Q9", "build --preset Q2X", "build --preset Q2GG", "build --seeding grid", "build --builder lbvh --m 33",
                            "build --builder embree-low --m 33", "build --builder lbvh:Q2",
                            // Words from a fixed set, parsed where they come in.
                            "build --metric mode", "render --layout bvh16", "render --quality mq",

@@ -18,7 +18,7 @@ namespace {
 TEST(KMeansGpu, ValidTreesAsGoodAsTheCpuBackend) {
   if (!cuda_device_available()) GTEST_SKIP() << "no CUDA device: the GPU backend is compiled but not run here";
   const PrimitiveSet prims = make_primitive_set(test::clustered_triangles(200000, 51));
-  for (const char* preset : {"Q1", "Q2", "Q3", "Q4", "Q5"})
+  for (const char* preset : {"Q1", "Q2", "Q3", "Q4", "Q5", "Q2G"})
     for (ClusterMetric metric : {ClusterMetric::Means, ClusterMetric::Medians})
       for (bool wide : {false, true}) {
         KMeansParams params = *kmeans_preset(preset);

@@ -83,7 +83,8 @@ TEST_P(EveryPreset, CpuSubtreePathBuildsTheLevelLoopsTree) {
       }
 }
 
-INSTANTIATE_TEST_SUITE_P(KMeans, EveryPreset, ::testing::Values("Q1", "Q2", "Q3", "Q4", "Q5", "QA", "Q1S", "Q3S", "QAS"));
+INSTANTIATE_TEST_SUITE_P(KMeans, EveryPreset, ::testing::Values("Q1", "Q2", "Q3", "Q4", "Q5", "QA", "Q1S", "Q3S", "QAS", "Q1G",
+                                                                "Q2GS", "QAG"));
 
 TEST(KMeansBuilder, FreeParameters) {
   const PrimitiveSet prims = make_primitive_set(test::random_triangles(5000, 4));
@@ -230,7 +231,7 @@ TEST_P(Degenerate, SharedCentroidAndZeroArea) {
   }
 }
 
-INSTANTIATE_TEST_SUITE_P(KMeans, Degenerate, ::testing::Values("Q1", "Q2", "Q3", "Q4", "Q5", "QA", "Q3S", "Q2R"));
+INSTANTIATE_TEST_SUITE_P(KMeans, Degenerate, ::testing::Values("Q1", "Q2", "Q3", "Q4", "Q5", "QA", "Q3S", "Q2R", "Q2G", "QAGS"));
 
 }  // namespace
 }  // namespace kmbvh

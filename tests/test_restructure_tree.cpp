@@ -58,7 +58,7 @@ TEST(RestructureTreelets, ValidAndNeverDearerThanWithoutPasses) {
 
 TEST(RestructureTreelets, RPresetsAreValidAndTheSameAtOneAndTwoThreads) {
   const PrimitiveSet prims = make_primitive_set(test::clustered_triangles(30000, 13));
-  for (const char* preset : {"Q1R", "Q2R", "QAR"}) {
+  for (const char* preset : {"Q1R", "Q2R", "QAR", "QAGR"}) {
     const KMeansParams params = *kmeans_preset(preset);
     EXPECT_EQ(params.restructure_passes, 2u) << preset;
     set_thread_count(1);
@@ -128,7 +128,7 @@ TEST(RestructureTreelets, TreesThatDoNotHoldTheSetAreRefused) {
 TEST(RestructureTreelets, PresetNamesAndRefusedCombinations) {
   EXPECT_EQ(parse_builder("Q3R").label(), "kmeans Q3R");
   EXPECT_EQ(parse_builder("qar").label(), "kmeans QAR");
-  for (const char* wrong : {"QR", "Q6R", "Q3RR", "Q3SR", "R"}) EXPECT_FALSE(kmeans_preset(wrong).has_value()) << wrong;
+  for (const char* wrong : {"QR", "Q6R", "Q3RR", "Q3SR", "R", "Q3RG", "Q3GG", "Q3GSR", "G"}) EXPECT_FALSE(kmeans_preset(wrong).has_value()) << wrong;
   KMeansParams params = *kmeans_preset("Q2R");
   EXPECT_TRUE(check_params(params).empty());
   params.wide = true;

@@ -52,7 +52,7 @@ nlohmann::json to_json(const Measurement& m) {
   nlohmann::json params = {{"max_leaf_size", c.max_leaf_size}};
   if (c.builder == BuilderKind::Kmeans) {
     params.update({{"k", c.kmeans.k}, {"p", c.kmeans.p}, {"i", c.kmeans.i}, {"seed", c.kmeans.seed},
-                   {"metric", to_string(c.kmeans.metric)}, {"wide", c.kmeans.wide},
+                   {"metric", to_string(c.kmeans.metric)}, {"seeding", to_string(c.kmeans.seeding)}, {"wide", c.kmeans.wide},
                    {"preset", c.preset.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.preset)},
                    {"backend", to_string(c.backend)}, {"level_loop", !c.kmeans.cpu_subtrees}});
   }

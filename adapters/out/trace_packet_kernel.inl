@@ -210,14 +210,16 @@ inline vdh half_lanes(const float* a, unsigned h) {
   return __builtin_convertvector(v, vdh);
 }
 
-// exact_within (watertight.h) of triangle (a, b, c) for every ray of the packet, one
-// bit a ray, over each ray's whole interval (tnear, tfar]: the interval an occlusion ray
+// exact_within (watertight.h) of triangle (a, b, c) for the rays `tested` of the packet,
+// one bit a ray, over each ray's whole interval (tnear, tfar]: the interval an occlusion ray
 // accepts its first candidate in. The same operations in the same order lane by lane
-// (IEEE double, no contraction), so each bit is what the scalar function answers.
-inline unsigned exact_within_lanes(const PacketLanes& lanes, Vec3 a, Vec3 b, Vec3 c) {
+// (IEEE double, no contraction; exact_within's), so each bit is what the scalar function
+// answers; the rare ray the exact barycentrics put outside the triangle is decided by the
+// scalar double-precision test, as alone.
+inline unsigned exact_within_lanes(const PacketLanes& lanes, const Ray* rays, unsigned tested, Vec3 a, Vec3 b, Vec3 c) {
   const ExactEdges e(a, b, c);
   const vlh sign_bit = vlh{} + (1ll << 63);
-  unsigned bits = 0;
+  unsigned bits = 0, doubtful = 0;
   for (unsigned h = 0; h < 2; ++h) {
     const vdh dx = half_lanes(lanes.dir[0], h), dy = half_lanes(lanes.dir[1], h), dz = half_lanes(lanes.dir[2], h);
     const vdh px = dy * e.e2z - dz * e.e2y, py = dz * e.e2x - dx * e.e2z, pz = dx * e.e2y - dy * e.e2x;
@@ -226,11 +228,20 @@ inline unsigned exact_within_lanes(const PacketLanes& lanes, Vec3 a, Vec3 b, Vec
               sz = half_lanes(lanes.org[2], h) - double(a.z);
     const vdh qx = sy * e.e1z - sz * e.e1y, qy = sz * e.e1x - sx * e.e1z, qz = sx * e.e1y - sy * e.e1x;
     const vdh T = e.e2x * qx + e.e2y * qy + e.e2z * qz;
-    const vlh sign = vlh(det) & sign_bit;  // the scalar code's negation of both where det < 0
+    const vdh U = sx * px + sy * py + sz * pz, V = dx * qx + dy * qy + dz * qz;
+    const vlh sign = vlh(det) & sign_bit;  // the scalar code's negation of all four where det < 0
     const vdh abs_det = vdh(vlh(det) ^ sign), signed_T = vdh(vlh(T) ^ sign);
-    const vlh within = (det == 0.0) | ((signed_T > half_lanes(lanes.tnear, h) * abs_det) &
-                                       (signed_T <= half_lanes(lanes.tfar, h) * abs_det));
-    bits |= half_mask_bits(within) << (h * kHalfPacket);
+    const vdh signed_U = vdh(vlh(U) ^ sign), signed_V = vdh(vlh(V) ^ sign);
+    const vlh parallel = det == 0.0;
+    const vlh within = (signed_T > half_lanes(lanes.tnear, h) * abs_det) & (signed_T <= half_lanes(lanes.tfar, h) * abs_det);
+    const vdh margin = -kExactOutside * abs_det;
+    const vlh inside = (signed_U >= margin) & (signed_V >= margin) & (abs_det - signed_U - signed_V >= margin);
+    bits |= half_mask_bits(parallel | (within & inside)) << (h * kHalfPacket);
+    doubtful |= half_mask_bits(~parallel & within & ~inside) << (h * kHalfPacket);
+  }
+  for (unsigned rest = doubtful & tested; rest; rest &= rest - 1) {
+    const unsigned i = __builtin_ctz(rest);
+    if (exact_watertight_hit(rays[i], a, b, c, rays[i].tnear, rays[i].tfar)) bits |= 1u << i;
   }
   return bits;
 }
@@ -292,7 +303,8 @@ __attribute__((always_inline)) inline void intersect_pack_rays(const TrianglePac
       if (!tested) continue;
       for (unsigned b = tested; b; b &= b - 1) count.exact();
       const unsigned passed =
-          tested & exact_within_lanes(lanes, slot_vertex(p, 0, slot), slot_vertex(p, 1, slot), slot_vertex(p, 2, slot));
+          tested & exact_within_lanes(lanes, rays, tested, slot_vertex(p, 0, slot), slot_vertex(p, 1, slot),
+                                      slot_vertex(p, 2, slot));
       for (unsigned b = passed; b; b &= b - 1) {
         const unsigned i = __builtin_ctz(b);
         Candidate c;

@@ -648,18 +648,6 @@ __attribute__((noinline)) bool traverse_exact(const WideBvh<W>& bvh, const Ray& 
   return finish(count, counted, finish_hit(bvh, found, check, hit));
 }
 
-// Whether the float test's closest candidate may not be the ray's closest hit: the exact
-// measure (e) puts the ray outside the triangle, so the float test passed it by more than
-// rounding. That happens on a needle seen along its length, whose float shear moves the
-// edge functions by 1e-4 of its width; found by the A/B mode in Embree's pathtracer on
-// conference (docs/design.md §8). A ray through an edge, whose exact barycentric is zero,
-// stays within the margin; the oracle's tolerance (hit_compare.cpp, 1e-5) is ten times it.
-inline bool outside_by_exact_check(const ExactCheck& e) {
-  constexpr double kOutside = 0x1p-20;
-  const double u = e.u, v = e.v;
-  return e.measured && (u < -kOutside || v < -kOutside || 1.0 - u - v < -kOutside);
-}
-
 // Whether the closest candidate's float t (t) lies within 2^-14 of its exact t (e), half
 // of cull_reach: what ordering near candidates by exact t assumes of every candidate. The
 // float t of a thin triangle whose vertices are far from the origin compared with its
@@ -685,6 +673,8 @@ __attribute__((always_inline)) inline bool conclude(const WideBvh<W>& bvh, const
       count.exact();
       s.check = exact_check(ray, slot_vertex(p, 0, slot), slot_vertex(p, 1, slot), slot_vertex(p, 2, slot),
                             ray.tnear, s.found_bound);
+      // Outside by the exact check: the float test passed a needle seen along its length (found
+      // by the A/B mode in Embree's pathtracer on conference, docs/design.md §8).
       if (outside_by_exact_check(s.check) || !distance_trusted(s.tmax, s.check))
         return traverse_exact<W>(bvh, ray, stack, hit, count, counted);
       if (!s.check.within)  // a needle's float t was off: once more, every candidate checked

@@ -17,6 +17,7 @@
 
 #include "distance.h"
 #include "level.h"
+#include "seed_cells.h"
 #include "update_means.h"
 
 namespace kmbvh {
@@ -118,6 +119,7 @@ struct RepresentativeTable {
 
 enum class AssignPass : uint8_t {
   Sums,          // a Lloyd iteration of k-means: fixed-point sums for the mean update
+  CellSums,      // cell seeding (seed_cells.h): the same sums, clusters by cell, not distance
   Final,         // counts per piece (for the partition) and cluster bounds
   SplitByIndex,  // the guaranteed split (partition.h): clusters by position, not distance
 };
@@ -215,14 +217,18 @@ struct AssignPiece {
     // A stable segment's sums would only reproduce its means (UpdateMeans keeps the
     // representatives of clusters left empty).
     if (Pass == AssignPass::Sums && level.per_node && seg.stable) return;
-    const bool count_changes = Pass != AssignPass::SplitByIndex && level.per_node;
+    // Cell seeding neither counts changes nor records its clusters: the first Lloyd
+    // iteration compares with what the slots held before, as it does without seeding.
+    constexpr bool by_distance = Pass == AssignPass::Sums || Pass == AssignPass::Final;
+    constexpr bool sums = Pass == AssignPass::Sums || Pass == AssignPass::CellSums;
+    const bool count_changes = by_distance && level.per_node;
     const uint32_t k = seg.k;
 
     RepresentativeTable<KMax, M> table;
-    if (Pass != AssignPass::SplitByIndex) table.load(level.clusters.reps + seg.cluster_base, k);
+    if (by_distance) table.load(level.clusters.reps + seg.cluster_base, k);
+    const CellGrid grid = CellGrid::of(seg.box, Pass == AssignPass::CellSums ? k : 1);
 
-    using Accumulator =
-        std::conditional_t<Pass == AssignPass::Sums, SumAccumulator<KMax>, BoundsAccumulator<KMax>>;
+    using Accumulator = std::conditional_t<sums, SumAccumulator<KMax>, BoundsAccumulator<KMax>>;
     Accumulator acc;
     acc.clear(k);
     uint32_t count[KMax];
@@ -234,10 +240,12 @@ struct AssignPiece {
       uint32_t c;
       if constexpr (Pass == AssignPass::SplitByIndex)
         c = static_cast<uint32_t>((uint64_t(i - seg.begin) * k) / seg.count);
+      else if constexpr (Pass == AssignPass::CellSums)
+        c = grid.cell(b);
       else
         c = table.nearest(b);
       if (count_changes) changed += level.cluster_of[i] != c;
-      level.cluster_of[i] = static_cast<uint8_t>(c);
+      if (Pass != AssignPass::CellSums) level.cluster_of[i] = static_cast<uint8_t>(c);
       ++count[c];
       acc.add(c, b);
     }
@@ -247,15 +255,14 @@ struct AssignPiece {
     const bool sole = seg.piece_count == 1;
     if (changed != 0) atomic_add(&level.segments[piece.segment].changed, changed);
     for (uint32_t c = 0; c < k; ++c) {
-      if constexpr (Pass != AssignPass::Sums)
-        level.piece_counters[piece.counter_base + c * seg.piece_count] = count[c];
+      if constexpr (!sums) level.piece_counters[piece.counter_base + c * seg.piece_count] = count[c];
       if (count[c] == 0) continue;
       const uint32_t slot = seg.cluster_base + c;
       if (sole)
         level.clusters.counts[slot] = count[c];
       else
         atomic_add(&level.clusters.counts[slot], count[c]);
-      if constexpr (Pass == AssignPass::Sums)
+      if constexpr (sums)
         acc.publish(c, count[c], frame, sole, level.clusters.sums[slot]);
       else
         acc.publish(c, sole, level.clusters.bounds[slot]);

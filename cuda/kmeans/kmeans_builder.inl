@@ -161,6 +161,13 @@ class KMeansLevels {
     const uint32_t clusters = set_up(segment_count);
     for_each_index(segment_count, InitialiseSegment<M>{ptr(boxes_[current_]), ptr(segments_), ptr(reps_),
                                                        rules(), params_.seed});
+    if (params_.seeding == Seeding::Cells) {
+      // Each representative with members in its cell becomes their mean (seed_cells.h),
+      // whatever the metric.
+      clear_clusters(clusters, true);
+      for_each_index(piece_count_, AssignPiece<KMax, M, AssignPass::CellSums>{view()});
+      for_each_index(clusters, UpdateMeans{ptr(segments_), this->clusters()});
+    }
     clock_.lap("initialise");
 
     for (uint32_t iteration = 0; iteration < params_.i; ++iteration) {

@@ -19,8 +19,10 @@ constexpr Preset kPresets[] = {
     {"Q1", 8, 5, 0, false},   {"Q2", 8, 5, 2, false},   {"Q3", 16, 5, 5, false},
     {"Q4", 32, 20, 10, false}, {"Q5", 64, 30, 15, false}, {"QA", 64, 30, 15, true},
 };
-constexpr const char* kNames[] = {"Q1",  "Q2",  "Q3",  "Q4",  "Q5",  "QA",  "Q1S", "Q2S", "Q3S", "Q4S",
-                                  "Q5S", "QAS", "Q1R", "Q2R", "Q3R", "Q4R", "Q5R", "QAR", nullptr};
+constexpr const char* kNames[] = {
+    "Q1",   "Q2",   "Q3",   "Q4",   "Q5",   "QA",   "Q1S",  "Q2S",  "Q3S",  "Q4S",  "Q5S",  "QAS",
+    "Q1R",  "Q2R",  "Q3R",  "Q4R",  "Q5R",  "QAR",  "Q1G",  "Q2G",  "Q3G",  "Q4G",  "Q5G",  "QAG",
+    "Q1GS", "Q2GS", "Q3GS", "Q4GS", "Q5GS", "QAGS", "Q1GR", "Q2GR", "Q3GR", "Q4GR", "Q5GR", "QAGR", nullptr};
 
 std::string upper(std::string s) {
   for (char& c : s) c = char(std::toupper(static_cast<unsigned char>(c)));
@@ -30,13 +32,19 @@ std::string upper(std::string s) {
 }  // namespace
 
 std::optional<KMeansParams> kmeans_preset(const std::string& name) {
+  // Two characters of preset, then G, then S or R, each optional.
   std::string wanted = upper(name);
-  const bool sah_leaves = wanted.size() == 3 && wanted.back() == 'S';
-  const bool restructure = wanted.size() == 3 && wanted.back() == 'R';
-  if (sah_leaves || restructure) wanted.pop_back();
+  if (wanted.size() < 2) return std::nullopt;
+  std::string suffix = wanted.substr(2);
+  wanted.resize(2);
+  const bool cells = !suffix.empty() && suffix.front() == 'G';
+  if (cells) suffix.erase(0, 1);
+  const bool sah_leaves = suffix == "S", restructure = suffix == "R";
+  if (!suffix.empty() && !sah_leaves && !restructure) return std::nullopt;
   for (const Preset& preset : kPresets) {
     if (wanted != preset.name) continue;
     KMeansParams params;
+    params.seeding = cells ? Seeding::Cells : Seeding::Farthest;
     params.sah_leaves = sah_leaves;
     params.restructure_passes = restructure ? BinaryBuildParams{}.treelet_iterations : 0;  // ATRBVH's own
     params.k = preset.k;
@@ -57,6 +65,8 @@ const char* const* kmeans_preset_names() { return kNames; }
 std::string to_string(ClusterMetric metric) {
   return metric == ClusterMetric::Means ? "means" : "medians";
 }
+
+std::string to_string(Seeding seeding) { return seeding == Seeding::Farthest ? "farthest" : "cells"; }
 
 std::string check_params(const KMeansParams& params) {
   if (params.k < 2 || params.k > KMeansParams::kMaxK)

@@ -12,6 +12,12 @@ enum class ClusterMetric : uint8_t {
   Medians,  // 6-D Manhattan distance, component-wise median update (the slides' k-medians)
 };
 
+// Where a node's representatives start (docs/design.md §4).
+enum class Seeding : uint8_t {
+  Farthest,  // the paper: a random primitive, then each the farthest of p random candidates
+  Cells,     // beyond the paper: the means of a grid of cells over the node (seed_cells.h)
+};
+
 struct KMeansParams {
   uint32_t k = 8;              // clusters per node
   uint32_t p = 5;              // candidates per representative at initialisation
@@ -19,6 +25,7 @@ struct KMeansParams {
   uint32_t max_leaf_size = 8;  // m: clusters of at most m primitives become leaves
   uint32_t seed = 1;
   ClusterMetric metric = ClusterMetric::Means;
+  Seeding seeding = Seeding::Farthest;
   bool wide = false;           // emit the k-ary tree directly instead of binary treelets
   // k, p and the number of Lloyd iterations chosen per node from its size, k, p and i
   // above being the caps (node_rules.h).
@@ -59,10 +66,13 @@ struct KMeansParams {
 // "Q1".."Q5" (case-insensitive), as in the paper's Table 1, and "QA", the adaptive preset:
 // k, p and the iteration cap per node (k up to 64, p up to 30, at most 15 iterations and
 // fewer for larger k), each node's Lloyd loop stopped once it moves at most 2% of its
-// primitives (node_rules.h). Each followed by S ("Q3S") is the same with SAH leaves.
+// primitives (node_rules.h). Each followed by S ("Q3S") is the same with SAH leaves, by R
+// ("Q3R") with treelets restructured; a G before either or alone ("Q1G", "Q2GS") seeds
+// each node from a grid of cells (Seeding::Cells).
 std::optional<KMeansParams> kmeans_preset(const std::string& name);
 const char* const* kmeans_preset_names();  // null-terminated list
 std::string to_string(ClusterMetric metric);
+std::string to_string(Seeding seeding);  // "farthest", "cells"
 
 // Empty when the parameters can be built with; else what is wrong, in words.
 std::string check_params(const KMeansParams& params);

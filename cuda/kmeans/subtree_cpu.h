@@ -21,6 +21,7 @@
 #include "initialise.h"
 #include "level.h"
 #include "params.h"
+#include "seed_cells.h"
 #include "update_means.h"
 #include "update_medians.h"
 
@@ -75,6 +76,7 @@ class SubtreeSplitter {
     Aabb reps[KMax];
     initialise_representatives<M>(boxes, p.count, k, rules.candidates(k), params_.seed, node_stream(p.begin, p.count),
                                   reps);
+    if (params_.seeding == Seeding::Cells) seed_from_cells(p, boxes, reps);
     // The first iteration compares with leftovers of another node, as the level loop's does.
     for (uint32_t iteration = 0; iteration < rules.iterations(k); ++iteration)
       if (rules.settled(update(p, boxes, reps), p.count) && iteration > 0 && rules.until_stable) break;
@@ -123,6 +125,37 @@ class SubtreeSplitter {
     return forced ? 1u : 0u;
   }
 
+  // Cell seeding (seed_cells.h): what the level loop's CellSums pass and mean update do
+  // to a segment of one piece.
+  void seed_from_cells(const Pending& p, const Aabb* boxes, Aabb* reps) const {
+    const CellGrid grid = CellGrid::of(p.box, p.k);
+    SumAccumulator<KMax> acc;
+    acc.clear(p.k);
+    uint32_t count[KMax];
+    for (uint32_t c = 0; c < p.k; ++c) count[c] = 0;
+    for (uint32_t x = 0; x < p.count; ++x) {
+      const uint32_t c = grid.cell(boxes[x]);
+      ++count[c];
+      acc.add(c, boxes[x]);
+    }
+    decode_means(p, acc, count, reps);
+  }
+
+  // Representatives of the clusters with members become their fixed-point means, as one
+  // piece of the level loop publishes them and UpdateMeans decodes them.
+  void decode_means(const Pending& p, const SumAccumulator<KMax>& acc, const uint32_t* count, Aabb* reps) const {
+    const FixedPointFrame frame = FixedPointFrame::of(p.box);
+    for (uint32_t c = 0; c < p.k; ++c) {
+      if (count[c] == 0) continue;
+      ClusterSums sums;
+      acc.publish(c, count[c], frame, /*sole=*/true, sums);
+      for (int d = 0; d < 3; ++d) {
+        reps[c].lo[d] = frame.decode_mean(sums.s[d], count[c], d);
+        reps[c].hi[d] = frame.decode_mean(sums.s[3 + d], count[c], d);
+      }
+    }
+  }
+
   // One Lloyd iteration after an assignment: the mean (fixed point, as one piece of the
   // level loop publishes it) or the component-wise median. Returns how many assignments
   // changed since the last iteration.
@@ -142,16 +175,7 @@ class SubtreeSplitter {
         ++count[c];
         acc.add(c, boxes[x]);
       }
-      const FixedPointFrame frame = FixedPointFrame::of(p.box);
-      for (uint32_t c = 0; c < p.k; ++c) {
-        if (count[c] == 0) continue;
-        ClusterSums sums;
-        acc.publish(c, count[c], frame, /*sole=*/true, sums);
-        for (int d = 0; d < 3; ++d) {
-          reps[c].lo[d] = frame.decode_mean(sums.s[d], count[c], d);
-          reps[c].hi[d] = frame.decode_mean(sums.s[3 + d], count[c], d);
-        }
-      }
+      decode_means(p, acc, count, reps);
     } else {
       for (uint32_t x = 0; x < p.count; ++x) {
         const uint32_t c = table.nearest(boxes[x]);

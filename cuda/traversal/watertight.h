@@ -190,11 +190,35 @@ KMBVH_HD KMBVH_FORCE_INLINE ExactCheck exact_check(const Ray& ray, Vec3 a, Vec3 
   return check;
 }
 
+// How far outside an edge, in barycentric units, the exact measure may put a hit the float
+// test accepted before the float test's inside/outside is doubted: a ray through an edge,
+// whose exact barycentric is zero, stays within it; the oracle's tolerance
+// (hit_compare.cpp, 1e-5) is ten times it. Beyond it the float test passed a needle seen
+// along its length, whose float shear moves the edge functions by 1e-4 of its width.
+constexpr double kExactOutside = 0x1p-20;
+
+// Whether the closest candidate's exact check puts the ray outside its triangle by more than
+// rounding, so that the float test's closest hit may not be the ray's (the closest-hit
+// kernels then trace the ray again in double precision).
+KMBVH_HD KMBVH_INLINE bool outside_by_exact_check(const ExactCheck& e) {
+  const double u = e.u, v = e.v;
+  return e.measured && (u < -kExactOutside || v < -kExactOutside || 1.0 - u - v < -kExactOutside);
+}
+
+// The double-precision watertight test of one triangle (intersect_watertight_exact), its
+// shear set up for this ray alone: for the rare candidate the float test cannot decide.
+KMBVH_HD KMBVH_COLD bool exact_watertight_hit(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, float tnear, float tmax) {
+  double t;
+  return intersect_watertight_exact(RayShearExact(ray), tnear, tmax, a, b, c, t);
+}
+
 // exact_check's `within` alone, for occlusion queries, which report no t, u or v: the
-// same measure of the plane without the barycentrics and without the division (t = T / det
-// compared with the interval as T against tnear * det and tmax * det, det's sign taken
-// out), about half the work. A ray parallel to the plane in double is left to the float
-// test, as there.
+// same measure of the plane without the division (t = T / det compared with the interval
+// as T against tnear * det and tmax * det), about half the work. A ray parallel to the
+// plane in double is left to the float test, as there. Where the exact barycentrics put
+// the ray outside the triangle by more than rounding, the float test passed a needle the
+// ray misses or grazes, and the double-precision watertight test decides: an occlusion ray
+// must not be stopped by a triangle it passes (the stress suite's needles, 2026-12-06).
 KMBVH_HD KMBVH_FORCE_INLINE bool exact_within(const Ray& ray, Vec3 a, Vec3 b, Vec3 c, float tnear, float tmax) {
   const ExactEdges e(a, b, c);
   const double dx = ray.dir.x, dy = ray.dir.y, dz = ray.dir.z;
@@ -204,8 +228,14 @@ KMBVH_HD KMBVH_FORCE_INLINE bool exact_within(const Ray& ray, Vec3 a, Vec3 b, Ve
   const double sx = double(ray.org.x) - a.x, sy = double(ray.org.y) - a.y, sz = double(ray.org.z) - a.z;
   const double qx = sy * e.e1z - sz * e.e1y, qy = sz * e.e1x - sx * e.e1z, qz = sx * e.e1y - sy * e.e1x;
   double T = e.e2x * qx + e.e2y * qy + e.e2z * qz;
-  if (det < 0.0) det = -det, T = -T;
-  return T > double(tnear) * det && T <= double(tmax) * det;
+  // The barycentrics' numerators; the packet kernel makes the same operations lane by lane
+  // (exact_within_lanes), so keep the order of every sum.
+  double U = sx * px + sy * py + sz * pz, V = dx * qx + dy * qy + dz * qz;
+  if (det < 0.0) det = -det, T = -T, U = -U, V = -V;
+  if (!(T > double(tnear) * det && T <= double(tmax) * det)) return false;
+  const double margin = -kExactOutside * det;
+  if (U >= margin && V >= margin && det - U - V >= margin) return true;
+  return exact_watertight_hit(ray, a, b, c, tnear, tmax);
 }
 
 // The watertight test decides hit or miss, but its sheared, origin-relative coordinates

@@ -36,6 +36,8 @@ struct BuilderOptions {
   uint32_t max_leaf_size = 8;
   uint32_t seed = 1;
   ClusterMetric metric = ClusterMetric::Means;
+  Seeding seeding = Seeding::Farthest;
+  CLI::Option* seeding_opt = nullptr;
   bool wide = false;
   bool adaptive = false, until_stable = false;
   float settle = 0.0f;

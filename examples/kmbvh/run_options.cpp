@@ -49,9 +49,9 @@ void add_run_options(CLI::App& cmd, RunOptions& run) {
 
 void add_builder_options(CLI::App& cmd, BuilderOptions& b) {
   cmd.add_option("--builder", b.builder,
-                  "sweep-sah, lbvh, hlbvh, atrbvh, ploc, kmeans (or Q1..Q5, QA; Q1S..Q5S, QAS: with SAH leaves; Q1R..Q5R, QAR: treelets restructured), embree-low, "
+                  "sweep-sah, lbvh, hlbvh, atrbvh, ploc, kmeans (or Q1..Q5, QA; Q1S..Q5S, QAS: with SAH leaves; Q1R..Q5R, QAR: treelets restructured; a G before the S or R or alone, Q2G, Q2GS: seeded from cells), embree-low, "
                   "embree-medium, embree-high");
-  cmd.add_option("--preset", b.preset, "k-means preset Q1..Q5 (the paper's) or QA (adaptive); followed by S (Q3S): with SAH leaves; by R (Q3R): treelets restructured");
+  cmd.add_option("--preset", b.preset, "k-means preset Q1..Q5 (the paper's) or QA (adaptive); followed by S (Q3S): with SAH leaves; by R (Q3R): treelets restructured; a G first (Q3G, Q3GS): seeded from cells");
   b.k_opt = cmd.add_option("--k", b.k, "k-means: clusters per node (2..64)");
   b.p_opt = cmd.add_option("--p", b.p, "k-means: candidates per representative");
   b.i_opt = cmd.add_option("--i", b.i, "k-means: Lloyd iterations (0 allowed)");
@@ -59,6 +59,9 @@ void add_builder_options(CLI::App& cmd, BuilderOptions& b) {
   cmd.add_option("--seed", b.seed, "k-means: seed of the counter-based random draws");
   add_choice(cmd, "--metric", b.metric, names_of({ClusterMetric::Means, ClusterMetric::Medians}),
              "k-means: means or medians");
+  b.seeding_opt = add_choice(cmd, "--seeding", b.seeding, names_of({Seeding::Farthest, Seeding::Cells}),
+                             "k-means: where a node's representatives start: farthest (the paper's draws) or cells "
+                             "(the means of a grid of cells over the node, as the G presets)");
   cmd.add_flag("--wide", b.wide, "k-means: emit the k-ary tree itself instead of binary treelets");
   b.adaptive_opt = cmd.add_flag("--adaptive", b.adaptive, "k-means: k and p per node from its size (--k, --p are caps)");
   b.until_stable_opt =
@@ -97,11 +100,12 @@ BuilderConfig builder_config(const BuilderOptions& o, const RunOptions& run) {
   if (config.builder == BuilderKind::Kmeans) {
     const auto given = [](const CLI::Option* opt) { return opt && opt->count() > 0; };
     const bool custom = given(o.k_opt) || given(o.p_opt) || given(o.i_opt) || given(o.adaptive_opt) ||
-                        given(o.until_stable_opt) || given(o.settle_opt);
+                        given(o.until_stable_opt) || given(o.settle_opt) || given(o.seeding_opt);
     if (custom) config.preset.clear();
     if (given(o.adaptive_opt)) config.kmeans.adaptive = o.adaptive;
     if (given(o.until_stable_opt)) config.kmeans.until_stable = o.until_stable;
     if (given(o.settle_opt)) config.kmeans.settle_fraction = o.settle;
+    if (given(o.seeding_opt)) config.kmeans.seeding = o.seeding;
     if (o.k_opt && o.k_opt->count()) config.kmeans.k = o.k;
     if (o.p_opt && o.p_opt->count()) config.kmeans.p = o.p;
     if (o.i_opt && o.i_opt->count()) config.kmeans.i = o.i;

@@ -75,6 +75,37 @@ class Builder {
     return reps;
   }
 
+  // Cell seeding: the node's box cut into the largest power of two of cells not above k,
+  // halving the longest cells each time; a cell with members gives its representative
+  // their mean.
+  void seed_from_cells(uint32_t begin, uint32_t end, std::vector<Point6>& reps) const {
+    const Aabb box = bounds(begin, end);
+    std::array<uint32_t, 3> n{1, 1, 1};
+    std::array<double, 3> extent{};
+    for (int d = 0; d < 3; ++d) extent[d] = double(box.hi[d]) - box.lo[d];
+    for (size_t cells = 2; cells <= reps.size(); cells *= 2) {
+      int longest = 0;
+      for (int d = 1; d < 3; ++d)
+        if (extent[d] / n[d] > extent[longest] / n[longest]) longest = d;
+      n[longest] *= 2;
+    }
+    std::vector<Point6> sum(reps.size(), Point6{});
+    std::vector<uint32_t> count(reps.size(), 0);
+    for (uint32_t i = begin; i < end; ++i) {
+      const Point6 x = point_of(prims_.boxes[order_[i]]);
+      uint32_t cell = 0;
+      for (int d = 2; d >= 0; --d) {
+        const double t = extent[d] > 0.0 ? ((x[d] + x[3 + d]) / 2 - box.lo[d]) / extent[d] * n[d] : 0.0;
+        cell = cell * n[d] + (t > 0.0 ? std::min(static_cast<uint32_t>(std::min(t, 1e9)), n[d] - 1) : 0u);
+      }
+      for (int d = 0; d < 6; ++d) sum[cell][d] += x[d];
+      ++count[cell];
+    }
+    for (size_t c = 0; c < reps.size(); ++c)
+      if (count[c] != 0)
+        for (int d = 0; d < 6; ++d) reps[c][d] = sum[c][d] / count[c];
+  }
+
   std::vector<uint32_t> assign(uint32_t begin, uint32_t end, const std::vector<Point6>& reps) const {
     std::vector<uint32_t> cluster(end - begin);
     for (uint32_t i = begin; i < end; ++i) {
@@ -110,6 +141,7 @@ class Builder {
     // Paper step 5: below m * k primitives, split in two.
     const uint32_t k = params_.k > 2 && count < m * params_.k ? 2 : params_.k;
     std::vector<Point6> reps = initialise(begin, end, k);
+    if (params_.cells) seed_from_cells(begin, end, reps);
     for (uint32_t it = 0; it < params_.i; ++it) update(begin, assign(begin, end, reps), reps);
     std::vector<uint32_t> cluster = assign(begin, end, reps);
     // Paper step 6: one cluster holding everything (coinciding boxes) is split by position.

@@ -16,6 +16,7 @@ namespace kmbvh::test {
 struct ReferenceKMeans {
   uint32_t k = 8, p = 5, i = 2, max_leaf_size = 8;
   uint32_t seed = 1;
+  bool cells = false;  // cell seeding (cuda/kmeans/seed_cells.h) after the paper's draws
 };
 
 // Binary tree (agglomerative treelets), leaves of at most max_leaf_size primitives.
