@@ -7,7 +7,7 @@ set -euo pipefail
 app=$1 lib=$2
 out=$(KMBVH_LOG=1 LD_PRELOAD="$lib" "$app" 200000 2>&1)
 echo "$out"
-grep -q "kmbvh: rtcBuildBVH: kmeans Q2S, 200000 primitives" <<<"$out"
+grep -q "kmbvh: rtcBuildBVH: kmeans Q1GS, 200000 primitives" <<<"$out"
 out=$(KMBVH_LOG=1 KMBVH_BUILDER=ploc LD_PRELOAD="$lib" "$app" 200000 2>&1)
 grep -q "kmbvh: rtcBuildBVH: ploc, 200000 primitives" <<<"$out"
 out=$(KMBVH_LOG=1 KMBVH_BUILDER=embree LD_PRELOAD="$lib" "$app" 200000 2>&1)
@@ -15,5 +15,5 @@ if grep -q "kmbvh: rtcBuildBVH" <<<"$out"; then echo "KMBVH_BUILDER=embree still
 grep -q "200000 leaves" <<<"$out"
 out=$(KMBVH_LOG=1 KMBVH_BUILDER=nonsense LD_PRELOAD="$lib" "$app" 200000 2>&1)
 grep -q "unknown builder 'nonsense'" <<<"$out"
-grep -q "kmbvh: rtcBuildBVH: kmeans Q2S" <<<"$out"
+grep -q "kmbvh: rtcBuildBVH: kmeans Q1GS" <<<"$out"
 echo "preload builder API: kmbvh by default, Embree on request, bad settings reported"
