@@ -315,7 +315,7 @@ TEST(Traversal, NeedlesPassedByTheFloatTestAreTracedExactlyInBvh2) {
 // 1e-4 wide) and a ray 200 units away that passes it by 5% of its width, which the float
 // test takes for a hit (Embree's test does not): no kernel may report it, as a closest hit
 // or as an occluder (watertight.h: exact_within decides such a candidate in double
-// precision), in any layout, alone or in a packet.
+// precision), in any layout, alone, in a packet or through a filter.
 TEST(Traversal, NeedlePassedByTheFloatTestOccludesNothing) {
   TriangleScene scene;
   scene.add_triangle(Vec3(54.8473282f, 51.3092918f, 76.3372574f), Vec3(33.3588791f, 72.7147217f, 29.7525482f),
@@ -339,6 +339,13 @@ TEST(Traversal, NeedlePassedByTheFloatTestOccludesNothing) {
       std::vector<Hit> packet(rays.size());
       tracer.trace_packet(rays.data(), 0b111, query, packet.data());
       for (const Hit& h : packet) EXPECT_FALSE(h.found()) << to_string(layout) << " packet";
+      // With a filter (Embree's filter functions): the needle is not even offered.
+      uint32_t offered = 0;
+      const HitFilter filter{[](void* user, const Ray&, const Hit&) { return ++*static_cast<uint32_t*>(user) > 0; },
+                             &offered};
+      Hit filtered;
+      EXPECT_FALSE(tracer.trace_one(ray, query, filtered, filter)) << to_string(layout) << " filtered";
+      EXPECT_EQ(offered, 0u) << to_string(layout);
     }
   }
 }

@@ -217,8 +217,10 @@ inline Vec3 slot_vertex(const TrianglePack& p, int v, uint32_t slot) {
 // How a pack's candidate hits are confirmed in double precision (watertight.h), which
 // keeps a needle's float t from landing on the wrong side of tnear or tmax:
 // - Exact: each by exact_check before it counts, which also gives the t, u and v the hit
-//   reports (a filter is offered complete hits);
-// - Interval: each by exact_within, the interval alone (occlusion reports no t, u or v);
+//   reports (a filter is offered complete hits), and by the double-precision test where
+//   the exact barycentrics put the ray outside the triangle (a needle);
+// - Interval: each by exact_within, the interval and that test (occlusion reports no t, u
+//   or v);
 // - Deferred: none while the ray runs; the closest hit's, once found, by exact_check over
 //   the interval it was accepted in (traverse), and in the rare case it fails there the ray
 //   is traced again with Exact. A closest-hit ray meets 1.1-1.3 candidates on average, so
@@ -347,8 +349,13 @@ __attribute__((always_inline)) inline int confirm_hits(const TrianglePack& p, co
     } else {
       count.exact();
       const ExactCheck e = exact_check(r.ray, vertex(0, slot), vertex(1, slot), vertex(2, slot), tnear, end);
-      if (e.within) c.check = e;
-      return e.within;
+      // A needle the float test hit and the exact barycentrics put the ray outside of: the
+      // double-precision test decides, before a filter is offered it (exact_within's rule).
+      const bool counts = e.within && (!outside_by_exact_check(e) ||
+                                       exact_watertight_hit(r.ray, vertex(0, slot), vertex(1, slot), vertex(2, slot),
+                                                            tnear, end));
+      if (counts) c.check = e;
+      return counts;
     }
   };
   for (; hits; hits &= hits - 1) {

@@ -6,7 +6,7 @@
 #define KMBVH_HD __host__ __device__
 #define KMBVH_INLINE __forceinline__
 #define KMBVH_FORCE_INLINE __forceinline__
-#define KMBVH_COLD __noinline__
+#define KMBVH_COLD static __noinline__  // static: one copy a translation unit, no ODR clash
 #else
 #define KMBVH_HD
 #define KMBVH_INLINE inline
