@@ -220,7 +220,7 @@ inline Vec3 slot_vertex(const TrianglePack& p, int v, uint32_t slot) {
 //   reports (a filter is offered complete hits), and by the double-precision test where
 //   the exact barycentrics put the ray outside the triangle (a needle);
 // - Interval: each by exact_within, the interval and that test (occlusion reports no t, u
-//   or v);
+//   or v), unless the float test's hit is certain (certain_hit);
 // - Deferred: none while the ray runs; the closest hit's, once found, by exact_check over
 //   the interval it was accepted in (traverse), and in the rare case it fails there the ray
 //   is traced again with Exact. A closest-hit ray meets 1.1-1.3 candidates on average, so
@@ -304,7 +304,8 @@ struct Search {
 template <Query query, Confirm confirm, typename Count>
 __attribute__((always_inline)) inline int confirm_hits(const TrianglePack& p, const TrianglePack* packs,
                                                        const PackRay& r, float tnear, Search& s, vfp t,
-                                                       unsigned hits, unsigned redo, Candidate& c, Count& count) {
+                                                       unsigned hits, unsigned redo, Candidate& c, Count& count,
+                                                       unsigned certain = 0) {
   // (The lambdas are forced inline too: an occlusion query's `accept` was left a call.)
   auto vertex = [&](int v, int slot) __attribute__((always_inline)) { return slot_vertex(p, v, uint32_t(slot)); };
   const bool prior = s.found_key != kNoCandidate;
@@ -344,6 +345,9 @@ __attribute__((always_inline)) inline int confirm_hits(const TrianglePack& p, co
       c.bound = end;
       return true;
     } else if constexpr (confirm == Confirm::Interval) {
+      // A hit certain over the search's interval (certain_hit) is certain over this one,
+      // which is no shorter: an occlusion query's is the same.
+      if ((certain >> slot & 1) && end >= s.cull) return true;
       count.exact();
       return exact_within(r.ray, vertex(0, slot), vertex(1, slot), vertex(2, slot), tnear, end);
     } else {
@@ -399,6 +403,7 @@ template <typename VF, typename VM>
 struct WatertightLanes {
   VM valid, exact_zero;
   VF T, det;
+  VF U, V, W;  // the edge functions (certain_hit)
 };
 template <typename VF, typename VM>
 __attribute__((always_inline)) inline WatertightLanes<VF, VM> watertight_lanes(const VF (&x)[3], const VF (&y)[3],
@@ -415,7 +420,7 @@ __attribute__((always_inline)) inline WatertightLanes<VF, VM> watertight_lanes(c
   const VM sign = VM(det) & (VM{} + int(0x80000000));
   const VF abs_det = VF(VM(det) ^ sign), abs_T = VF(VM(T) ^ sign);
   return {~(negative & positive) & (det != zero) & (abs_T > tnear * abs_det) & (abs_T <= reach * abs_det),
-          (U == zero) | (V == zero) | (W == zero), T, det};
+          (U == zero) | (V == zero) | (W == zero), T, det, U, V, W};
 }
 
 // The watertight test (cuda/traversal/watertight.h) on a pack of triangles at once, in the
@@ -441,8 +446,13 @@ __attribute__((always_inline)) inline int intersect_pack(const TrianglePack& p, 
   const unsigned hits = mask_bits(w.valid & ~w.exact_zero) & ~skip;
   const unsigned redo = mask_bits(w.exact_zero) & ~skip;
   if (!(hits | redo)) return -1;
-  if constexpr (query == Query::Any)
-    return confirm_hits<query, confirm>(p, packs, r, tnear, search, w.T / w.det, hits, redo, c, count);
+  if constexpr (query == Query::Any) {
+    unsigned certain = 0;  // hits that need no exact check (watertight.h: certain_hit)
+    if constexpr (confirm == Confirm::Interval)
+      certain = hits & mask_bits(certain_hit<vfp>(x, y, z, r.sz, w.U, w.V, w.W, w.T, w.det, r.tnear,
+                                                   splat<vfp>(search.cull)));
+    return confirm_hits<query, confirm>(p, packs, r, tnear, search, w.T / w.det, hits, redo, c, count, certain);
+  }
   else
     return confirm_hits_apart<query, confirm>(p, packs, r, tnear, search, w.T / w.det, hits, redo, c, count);
 }

@@ -238,6 +238,50 @@ KMBVH_HD KMBVH_FORCE_INLINE bool exact_within(const Ray& ray, Vec3 a, Vec3 b, Ve
   return exact_watertight_hit(ray, a, b, c, tnear, tmax);
 }
 
+// Whether a hit the float watertight test accepted is certain, so that exact_within would
+// accept it too and an occlusion query need not make it (about 15% of a shadow ray's time
+// on the rooms). Certain means every edge function and both ends of the interval lie
+// further from the decision than the float arithmetic can have moved them from their
+// exact values (the float ray and vertices, exact arithmetic). With u = 2^-24 and kz the
+// direction's largest component (so |sx|, |sy| <= 1): a sheared coordinate x = dx - sx z is
+// within 4u (|dx| + |z|) <= 4u (|x| + 2|z|) <= 4u E of its exact value, E the largest such
+// bound of the three vertices; an edge function (x y' - y x', |x|, |y| <= M) is then
+// within 2 * 2 * 4u M E plus its own roundings, 4u M^2, so within 20u M E; det, their sum,
+// within 3 * 20u M E + 2u |det|; and T within Z times that plus 6u Z |det|, Z the largest
+// |sz z| (t is a convex combination of the sz z, so the comparisons' own roundings stay
+// below u Z |det| too). The bounds used are 12 times those and more, so that the
+// double-precision check's own roundings never decide either. The edge functions must
+// share det's sign (the float test's `valid`); x, y, z, U, V, W, T and det are the float
+// test's (watertight_lanes), F a float or a vector of floats, and the result is a
+// comparison's (a bool, or a lane mask). A non-finite E, or one below 2^-40 (products
+// that may underflow), is never certain.
+template <typename F>
+KMBVH_HD KMBVH_INLINE auto certain_hit(const F (&x)[3], const F (&y)[3], const F (&z)[3], F sz, F U, F V, F W, F T,
+                                       F det, F tnear, F end) {
+  const auto max = [](F a, F b) { return a < b ? b : a; };
+  const auto abs = [&](F a) { return max(a, -a); };  // two instructions on vectors (NaN stays NaN)
+  const auto min = [](F a, F b) { return b < a ? b : a; };
+  F width[3], depth[3];
+  for (int v = 0; v < 3; ++v) {
+    width[v] = max(abs(x[v]), abs(y[v]));
+    depth[v] = abs(z[v]);
+  }
+  const F M = max(width[0], max(width[1], width[2]));
+  const F D = max(depth[0], max(depth[1], depth[2]));
+  const F E = M + (D + D);
+  const F Z = abs(sz) * D;
+  const F e = (M * E) * 0x1p-16f;  // 256u M E: an edge function's reach
+  const F abs_det = abs(det), abs_T = det < F{} ? -T : T;
+  const F e_det = (e + e + e + e) + abs_det * 0x1p-20f;
+  const F e_T = Z * e_det;
+  // t > tnear and t <= end at the far side of det's reach, whatever their signs (an
+  // infinite end is met by every finite t).
+  const F near_det = tnear < F{} ? abs_det - e_det : abs_det + e_det;
+  const F end_det = end < F{} ? abs_det + e_det : abs_det - e_det;
+  return (E > F{} + 0x1p-40f) & (min(abs(U), min(abs(V), abs(W))) > e) & (abs_T - e_T > tnear * near_det) &
+         (abs_T + e_T <= end * end_det);
+}
+
 // The watertight test decides hit or miss, but its sheared, origin-relative coordinates
 // lose digits of t, u and v when the triangle is thin and seen almost edge-on from far
 // away (a wall across a room: u off by 1e-3 in float, by any float method; Embree's too).
