@@ -77,8 +77,14 @@ std::string BuilderConfig::label() const {
   if (!preset.empty()) return fmt::format("kmeans {}{}{}", preset, medians, wide);
   const std::string adaptive = kmeans.adaptive ? " adaptive" : "";
   const std::string cells = kmeans.seeding == Seeding::Cells ? " cells" : "";
-  const std::string leaves = std::string(kmeans.sah_leaves ? " sah-leaves" : "") +
-                             (kmeans.restructure_passes > 0 ? " restructured" : "");
+  const KMeansParams plain;
+  const bool own_treelets = kmeans.restructure_treelet_size != plain.restructure_treelet_size ||
+                            kmeans.restructure_passes != defaults.treelet_iterations;
+  const std::string leaves =
+      std::string(kmeans.sah_leaves ? " sah-leaves" : "") +
+      (kmeans.restructure_passes == 0 ? ""
+       : own_treelets ? fmt::format(" restructured(t={} i={})", kmeans.restructure_treelet_size, kmeans.restructure_passes)
+                      : " restructured");
   const std::string stable = !kmeans.until_stable         ? ""
                              : kmeans.settle_fraction > 0 ? fmt::format(" until-stable({:g})", kmeans.settle_fraction)
                                                           : " until-stable";

@@ -93,6 +93,30 @@ TEST(Cli, CellSeedingByPresetOrOption) {
   }
 }
 
+// The R presets restructure with ATRBVH's treelets; --treelet-size and --treelet-iterations
+// reach them too (a configuration of its own, labelled with both).
+TEST(Cli, TreeletOptionsReachTheRestructuredPresets) {
+  const Result plain = run("build " + small_obj().string() + " --builder Q1GR --runs 1 --warmup 0 --json -q");
+  ASSERT_EQ(plain.exit_code, 0) << plain.err;
+  const auto p = nlohmann::json::parse(plain.out);
+  EXPECT_EQ(p["builder"], "kmeans Q1GR");
+  EXPECT_EQ(p["params"]["restructure_passes"], 2);
+  EXPECT_EQ(p["params"]["treelet_size"], 9);
+  const Result own = run("build " + small_obj().string() +
+                         " --builder Q1GR --treelet-size 5 --treelet-iterations 1 --runs 1 --warmup 0 --json -q");
+  ASSERT_EQ(own.exit_code, 0) << own.err;
+  const auto j = nlohmann::json::parse(own.out);
+  EXPECT_EQ(j["builder"], "kmeans k=8 p=5 i=0 cells restructured(t=5 i=1)");
+  EXPECT_EQ(j["params"]["restructure_passes"], 1);
+  EXPECT_EQ(j["params"]["treelet_size"], 5);
+  EXPECT_TRUE(j["valid"].get<bool>());
+  for (const char* bad : {"--treelet-size 2", "--treelet-size 17", "--treelet-iterations 0"}) {
+    const Result r = run("build " + small_obj().string() + " --builder Q1GR " + bad + " --runs 1 -q");
+    EXPECT_NE(r.exit_code, 0) << bad;
+    EXPECT_NE(r.err.find("treelet"), std::string::npos) << bad << ": " << r.err;
+  }
+}
+
 TEST(Cli, EmbreeBuilderAndTable) {
   const Result r = run("build " + small_obj().string() + " --builder embree-medium --runs 1");
   ASSERT_EQ(r.exit_code, 0) << r.err;

@@ -55,6 +55,9 @@ nlohmann::json to_json(const Measurement& m) {
                    {"metric", to_string(c.kmeans.metric)}, {"seeding", to_string(c.kmeans.seeding)}, {"wide", c.kmeans.wide},
                    {"preset", c.preset.empty() ? nlohmann::json(nullptr) : nlohmann::json(c.preset)},
                    {"backend", to_string(c.backend)}, {"level_loop", !c.kmeans.cpu_subtrees}});
+    if (c.kmeans.restructure_passes > 0)
+      params.update({{"restructure_passes", c.kmeans.restructure_passes},
+                     {"treelet_size", c.kmeans.restructure_treelet_size}});
   }
   nlohmann::json phases = nlohmann::json::object();
   for (const auto& [name, ms] : m.info.phase_ms) phases[name] = ms;

@@ -41,6 +41,7 @@ Bvh build_kmeans(const PrimitiveSet& prims, const KMeansParams& params, Backend 
     BinaryBuildParams binary;
     binary.max_leaf_size = params.max_leaf_size;
     binary.treelet_iterations = params.restructure_passes;
+    binary.treelet_size = params.restructure_treelet_size;
     return restructure_treelets(prims, clustered, binary, backend, info, context);
   }
   if (!params.sah_leaves) return build_on(backend, prims, params, info, context);

@@ -47,6 +47,7 @@ std::optional<KMeansParams> kmeans_preset(const std::string& name) {
     params.seeding = cells ? Seeding::Cells : Seeding::Farthest;
     params.sah_leaves = sah_leaves;
     params.restructure_passes = restructure ? BinaryBuildParams{}.treelet_iterations : 0;  // ATRBVH's own
+    params.restructure_treelet_size = BinaryBuildParams{}.treelet_size;
     params.k = preset.k;
     params.p = preset.p;
     params.i = preset.i;
@@ -68,6 +69,9 @@ std::string to_string(ClusterMetric metric) {
 
 std::string to_string(Seeding seeding) { return seeding == Seeding::Farthest ? "farthest" : "cells"; }
 
+static_assert(KMeansParams{}.restructure_treelet_size == BinaryBuildParams{}.treelet_size,
+              "the R presets restructure as ATRBVH does by default");
+
 std::string check_params(const KMeansParams& params) {
   if (params.k < 2 || params.k > KMeansParams::kMaxK)
     return fmt::format("k must be in [2, {}], got {}", KMeansParams::kMaxK, params.k);
@@ -80,6 +84,10 @@ std::string check_params(const KMeansParams& params) {
     return "restructured treelets make a binary tree with its own SAH leaves: not with --wide or SAH leaves";
   if (params.restructure_passes > 100)
     return fmt::format("restructuring passes must be at most 100, got {}", params.restructure_passes);
+  if (params.restructure_passes > 0 &&
+      (params.restructure_treelet_size < 3 || params.restructure_treelet_size > BinaryBuildParams::kMaxTreeletSize))
+    return fmt::format("the treelet size must be in [3, {}], got {}", BinaryBuildParams::kMaxTreeletSize,
+                       params.restructure_treelet_size);
   if (params.restructure_passes > 0 && params.max_leaf_size > BinaryBuildParams::kMaxLeafSize)
     return fmt::format("restructured treelets take leaves of at most {} primitives, got m = {}",
                        BinaryBuildParams::kMaxLeafSize, params.max_leaf_size);

@@ -57,8 +57,10 @@ struct KMeansParams {
   // down to one primitive a leaf, then ATRBVH's agglomerative treelet passes over the tree
   // and leaves collapsed by SAH (cuda/atrbvh/restructure_tree.inl). The treelets regroup
   // the clusters' overlapping boxes in the levels near the leaves (docs/design.md §4).
-  // 0: off; otherwise the passes.
+  // 0: off; otherwise the passes, over treelets of restructure_treelet_size leaves (the R
+  // presets: ATRBVH's defaults, BinaryBuildParams).
   uint32_t restructure_passes = 0;
+  uint32_t restructure_treelet_size = 9;
 
   static constexpr uint32_t kMaxK = 64;  // local arrays in the kernels are sized by this
 };

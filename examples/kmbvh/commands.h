@@ -44,6 +44,7 @@ struct BuilderOptions {
   CLI::Option *adaptive_opt = nullptr, *until_stable_opt = nullptr, *settle_opt = nullptr;
   bool level_loop = false;  // k-means: every level through the portable level loop (the GPU's path)
   BinaryBuildParams binary;  // ploc radius, treelet size and iterations
+  CLI::Option *treelet_size_opt = nullptr, *treelet_iterations_opt = nullptr;  // also the R presets'
 };
 
 struct BuildCommand {

@@ -75,8 +75,10 @@ void add_builder_options(CLI::App& cmd, BuilderOptions& b) {
 
 void add_reference_options(CLI::App& cmd, BuilderOptions& o) {
   cmd.add_option("--ploc-radius", o.binary.ploc_radius, "PLOC: neighbours searched on each side");
-  cmd.add_option("--treelet-size", o.binary.treelet_size, "ATRBVH: leaves of a restructured treelet");
-  cmd.add_option("--treelet-iterations", o.binary.treelet_iterations, "ATRBVH: restructuring passes");
+  o.treelet_size_opt = cmd.add_option("--treelet-size", o.binary.treelet_size,
+                                      "ATRBVH and the k-means R presets: leaves of a restructured treelet");
+  o.treelet_iterations_opt = cmd.add_option("--treelet-iterations", o.binary.treelet_iterations,
+                                            "ATRBVH and the k-means R presets: restructuring passes");
   cmd.add_flag("--level-loop", o.level_loop,
                "k-means: run every level through the portable level loop, as the GPU does (no CPU subtree path), so "
                "its phases are timed apart; the tree is the same");
@@ -99,9 +101,18 @@ BuilderConfig builder_config(const BuilderOptions& o, const RunOptions& run) {
   config.binary = o.binary;
   if (config.builder == BuilderKind::Kmeans) {
     const auto given = [](const CLI::Option* opt) { return opt && opt->count() > 0; };
+    const bool restructured = config.kmeans.restructure_passes > 0;
+    const bool treelets = restructured && (given(o.treelet_size_opt) || given(o.treelet_iterations_opt));
     const bool custom = given(o.k_opt) || given(o.p_opt) || given(o.i_opt) || given(o.adaptive_opt) ||
-                        given(o.until_stable_opt) || given(o.settle_opt) || given(o.seeding_opt);
+                        given(o.until_stable_opt) || given(o.settle_opt) || given(o.seeding_opt) || treelets;
     if (custom) config.preset.clear();
+    if (restructured && given(o.treelet_size_opt)) config.kmeans.restructure_treelet_size = o.binary.treelet_size;
+    if (restructured && given(o.treelet_iterations_opt)) {
+      if (o.binary.treelet_iterations == 0)
+        throw std::invalid_argument("--treelet-iterations: an R preset restructures at least once (for none, "
+                                    "drop the R)");
+      config.kmeans.restructure_passes = o.binary.treelet_iterations;
+    }
     if (given(o.adaptive_opt)) config.kmeans.adaptive = o.adaptive;
     if (given(o.until_stable_opt)) config.kmeans.until_stable = o.until_stable;
     if (given(o.settle_opt)) config.kmeans.settle_fraction = o.settle;
