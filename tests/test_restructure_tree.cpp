@@ -79,14 +79,36 @@ TEST(RestructureTreelets, RPresetsAreTheRestructuredBreadthFirstTree) {
   for (const char* preset : {"Q2R", "QAR"}) {
     const KMeansParams params = *kmeans_preset(preset);
     KMeansParams fine = params;
-    fine.max_leaf_size = 1;
+    fine.max_leaf_size = KMeansParams::kSahLeafCluster;
     fine.restructure_passes = 0;
     ASSERT_TRUE(fine.breadth_first);
     BinaryBuildParams binary;
     binary.max_leaf_size = params.max_leaf_size;
     binary.treelet_iterations = params.restructure_passes;
+    binary.treelet_size = params.restructure_treelet_size;
     const Bvh expected = restructure_treelets(prims, build_kmeans(prims, fine), binary);
     EXPECT_TRUE(same_tree(build_kmeans(prims, params), expected)) << preset;
+  }
+}
+
+// The R presets cluster down to three primitives, not one, before the treelets (half the
+// clustering's time): the treelets regroup what the binary rewrite splits, so the tree
+// costs what restructuring clusters of one gives, within 1% (docs/design.md §4).
+TEST(RestructureTreelets, ClustersOfThreeCostWhatClustersOfOneCost) {
+  for (const TriangleScene& scene : {test::clustered_triangles(30000, 15), test::random_triangles(20000, 3)}) {
+    const PrimitiveSet prims = make_primitive_set(scene);
+    for (const char* preset : {"Q1GR", "Q2R"}) {
+      const KMeansParams params = *kmeans_preset(preset);
+      KMeansParams ones = params;
+      ones.max_leaf_size = 1;
+      ones.restructure_passes = 0;
+      BinaryBuildParams binary;
+      binary.max_leaf_size = params.max_leaf_size;
+      binary.treelet_iterations = params.restructure_passes;
+      const double three = sah_cost(build_kmeans(prims, params));
+      const double one = sah_cost(restructure_treelets(prims, build_kmeans(prims, ones), binary));
+      EXPECT_LE(three, one * 1.01) << preset;
+    }
   }
 }
 

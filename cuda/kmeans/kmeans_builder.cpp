@@ -33,8 +33,10 @@ Bvh build_kmeans(const PrimitiveSet& prims, const KMeansParams& params, Backend 
   if (const std::string problem = check_params(params); !problem.empty()) throw std::invalid_argument(problem);
   require_backend(backend);
   if (params.restructure_passes > 0) {
+    // Clusters of up to three, as for SAH leaves: the rewrite into a binary tree splits them,
+    // and the treelets regroup them as they do clusters of one (docs/design.md §4).
     KMeansParams fine = params;
-    fine.max_leaf_size = 1;
+    fine.max_leaf_size = std::min(params.max_leaf_size, KMeansParams::kSahLeafCluster);
     fine.restructure_passes = 0;
     fine.breadth_first = false;
     const Bvh clustered = build_on(backend, prims, fine, info, context);
