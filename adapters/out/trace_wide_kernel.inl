@@ -452,9 +452,9 @@ __attribute__((always_inline)) inline int intersect_pack(const TrianglePack& p, 
       certain = hits & mask_bits(certain_hit<vfp>(x, y, z, r.sz, w.U, w.V, w.W, w.T, w.det, r.tnear,
                                                    splat<vfp>(search.cull)));
     return confirm_hits<query, confirm>(p, packs, r, tnear, search, w.T / w.det, hits, redo, c, count, certain);
-  }
-  else
+  } else {
     return confirm_hits_apart<query, confirm>(p, packs, r, tnear, search, w.T / w.det, hits, redo, c, count);
+  }
 }
 
 // Completes the hit on triangle `found` (hit.t is set): its ids, and unless `refine` is

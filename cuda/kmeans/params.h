@@ -54,9 +54,10 @@ struct KMeansParams {
   // already leaves a third more triangles per ray (docs/results.md).
   static constexpr uint32_t kSahLeafCluster = 3;
   // Treelets restructured (a configuration beyond the paper, the presets with an R): cluster
-  // down to kSahLeafCluster primitives a leaf, then ATRBVH's agglomerative treelet passes over the tree
-  // and leaves collapsed by SAH (cuda/atrbvh/restructure_tree.inl). The treelets regroup
-  // the clusters' overlapping boxes in the levels near the leaves (docs/design.md §4).
+  // down to kSahLeafCluster primitives a leaf, then ATRBVH's agglomerative treelet passes
+  // over the tree and leaves collapsed by SAH (cuda/atrbvh/restructure_tree.inl). The
+  // treelets regroup the clusters' overlapping boxes in the levels near the leaves
+  // (docs/design.md §4).
   // 0: off; otherwise the passes, over treelets of restructure_treelet_size leaves (the R
   // presets: ATRBVH's defaults, BinaryBuildParams).
   uint32_t restructure_passes = 0;
