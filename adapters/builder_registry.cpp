@@ -21,7 +21,7 @@ constexpr KindName kKindNames[] = {
     {BuilderKind::Hlbvh, "hlbvh"},          {BuilderKind::Atrbvh, "atrbvh"},
     {BuilderKind::Ploc, "ploc"},            {BuilderKind::Kmeans, "kmeans"},
     {BuilderKind::EmbreeLow, "embree-low"}, {BuilderKind::EmbreeMedium, "embree-medium"},
-    {BuilderKind::EmbreeHigh, "embree-high"},
+    {BuilderKind::EmbreeHigh, "embree-high"}, {BuilderKind::EmbreeBvh8, "embree-bvh8"},
 };
 
 EmbreeQuality embree_quality(BuilderKind kind) {
@@ -56,7 +56,8 @@ const std::vector<BuilderKind>& builder_kinds() {
 }
 
 bool is_embree_builder(BuilderKind kind) {
-  return kind == BuilderKind::EmbreeLow || kind == BuilderKind::EmbreeMedium || kind == BuilderKind::EmbreeHigh;
+  return kind == BuilderKind::EmbreeLow || kind == BuilderKind::EmbreeMedium || kind == BuilderKind::EmbreeHigh ||
+         kind == BuilderKind::EmbreeBvh8;
 }
 
 bool is_binary_builder(BuilderKind kind) {
@@ -106,7 +107,7 @@ BuilderConfig parse_builder(const std::string& spec) {
   if (!kind)
     throw std::invalid_argument(fmt::format(
         "unknown builder '{}' (sweep-sah, lbvh, hlbvh, atrbvh, ploc, kmeans, Q1..Q5, QA, Q1S..Q5S, QAS, Q1R..Q5R, QAR, G before S, R or alone (Q2GS), "
-        "embree-low|medium|high)", spec));
+        "embree-low|medium|high|bvh8)", spec));
   config.builder = *kind;
   if (*kind == BuilderKind::Kmeans) {
     const auto params = kmeans_preset(preset);
@@ -179,6 +180,7 @@ Bvh run_builder(const BuilderConfig& config, const PrimitiveSet& prims, BuildInf
       options.max_leaf_size = config.max_leaf_size;
       return build_embree(prims, options, info);
     }
+    case BuilderKind::EmbreeBvh8: return build_embree(prims, embree_scene_bvh8_options(config.max_leaf_size), info);
   }
   throw std::invalid_argument(fmt::format("unknown builder kind {}", int(config.builder)));
 }
@@ -186,7 +188,9 @@ Bvh run_builder(const BuilderConfig& config, const PrimitiveSet& prims, BuildInf
 ValidationLimits validation_limits(const BuilderConfig& config) {
   ValidationLimits limits;
   limits.max_leaf_size = config.max_leaf_size;
-  limits.max_arity = (config.builder == BuilderKind::Kmeans && config.kmeans.wide) ? config.kmeans.k : 2;
+  limits.max_arity = config.builder == BuilderKind::EmbreeBvh8                     ? 8
+                     : (config.builder == BuilderKind::Kmeans && config.kmeans.wide) ? config.kmeans.k
+                                                                                      : 2;
   return limits;
 }
 

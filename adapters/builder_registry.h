@@ -19,16 +19,18 @@ namespace kmbvh {
 // Every builder the registry runs: kmbvh's own, then Embree's. Names are parsed into this
 // once, where they come in (parse_builder: the command line, the plug-in's environment), and
 // everything past that point switches on the kind.
-enum class BuilderKind { SweepSah, Lbvh, Hlbvh, Atrbvh, Ploc, Kmeans, EmbreeLow, EmbreeMedium, EmbreeHigh };
+enum class BuilderKind { SweepSah, Lbvh, Hlbvh, Atrbvh, Ploc, Kmeans, EmbreeLow, EmbreeMedium, EmbreeHigh, EmbreeBvh8 };
 
-// "sweep-sah", "lbvh", "hlbvh", "atrbvh", "ploc", "kmeans", "embree-low", "embree-medium", "embree-high".
+// "sweep-sah", "lbvh", "hlbvh", "atrbvh", "ploc", "kmeans", "embree-low", "embree-medium", "embree-high",
+// "embree-bvh8".
 const char* to_string(BuilderKind kind);
 // The kind of a builder's name (as to_string writes it), or none.
 std::optional<BuilderKind> builder_kind(const std::string& name);
 // Every kind, in the order above.
 const std::vector<BuilderKind>& builder_kinds();
 
-// embree-low, embree-medium, embree-high: Embree's own builders, not kmbvh's.
+// embree-low, embree-medium, embree-high, embree-bvh8: Embree's own builders, not kmbvh's
+// (embree-bvh8: an 8-ary tree with the settings of Embree's scene BVH, embree_builder.h).
 bool is_embree_builder(BuilderKind kind);
 // lbvh, hlbvh, atrbvh, ploc: the binary builders of the portable loop (BinaryBuildParams).
 bool is_binary_builder(BuilderKind kind);

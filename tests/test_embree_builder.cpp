@@ -3,6 +3,7 @@
 #include <gtest/gtest.h>
 
 #include "adapters/embree/embree_builder.h"
+#include "adapters/out/collapse_wide.h"
 #include "cuda/metrics/tree_stats.h"
 #include "cuda/metrics/validate.h"
 #include "support/scenes.h"
@@ -51,6 +52,26 @@ TEST(EmbreeBuilder, MediumUsesTheSahConstants) {
   dear_leaves.intersection_cost = 10.0f;
   EXPECT_GT(tree_stats(build_embree(prims, cheap_leaves)).mean_leaf_size,
             tree_stats(build_embree(prims, dear_leaves)).mean_leaf_size);
+}
+
+TEST(EmbreeBuilder, SceneBvh8SettingsGiveWideNodesAndFullerLeaves) {
+  // The tree Embree's scene builder makes: up to eight children a node, and leaves costed
+  // by blocks of four, so a leaf of one to three triangles is rarely chosen.
+  const PrimitiveSet prims = make_primitive_set(test::clustered_triangles(20000, 36));
+  const Bvh wide = build_embree(prims, embree_scene_bvh8_options(8));
+  ValidationLimits limits;
+  limits.max_arity = 8;
+  const ValidationReport r = validate(wide, prims, limits);
+  EXPECT_TRUE(r.ok()) << r.summary();
+  EXPECT_GT(tree_arity(wide), 4u);
+  EXPECT_LE(tree_arity(wide), 8u);
+  EmbreeBuildOptions medium;
+  medium.quality = EmbreeQuality::Medium;
+  EXPECT_GT(tree_stats(wide).mean_leaf_size, tree_stats(build_embree(prims, medium)).mean_leaf_size + 1.0);
+  for (uint32_t n : {0u, 1u, 5u}) {
+    const PrimitiveSet tiny = make_primitive_set(test::random_triangles(n, 37));
+    EXPECT_TRUE(validate(build_embree(tiny, embree_scene_bvh8_options(8)), tiny, limits).ok()) << n;
+  }
 }
 
 }  // namespace

@@ -31,7 +31,7 @@ size_t rays_per_kind() {
 
 constexpr const char* kBuilders[] = {"sweep-sah", "lbvh",     "hlbvh",    "atrbvh",     "ploc",
                                      "Q1",        "Q2",       "Q3",       "Q4",         "Q5",
-                                     "Q2+wide4",  "Q2+wide8", "Q2R",        "embree-low", "embree-medium", "embree-high"};
+                                     "Q2+wide4",  "Q2+wide8", "Q2R",        "embree-low", "embree-medium", "embree-high", "embree-bvh8"};
 constexpr RayKind kKinds[] = {RayKind::Primary, RayKind::Shadow, RayKind::Diffuse};
 
 // One scene's rays and Embree's answers to them.

@@ -108,7 +108,7 @@ TEST(StressReport, SummaryHasACaseARowAndAFailureInBold) {
 }
 
 TEST(BuilderKinds, EveryNameParsesToItsKindAndBack) {
-  ASSERT_EQ(builder_kinds().size(), 9u);
+  ASSERT_EQ(builder_kinds().size(), 10u);
   for (const BuilderKind kind : builder_kinds()) {
     EXPECT_EQ(builder_kind(to_string(kind)), kind);
     EXPECT_EQ(parse_builder(to_string(kind)).builder, kind) << to_string(kind);

@@ -3,6 +3,7 @@
 #include <embree3/rtcore.h>
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <chrono>
 #include <deque>
 #include <new>
@@ -107,6 +108,18 @@ const char* to_string(EmbreeQuality q) {
   }
 }
 
+EmbreeBuildOptions embree_scene_bvh8_options(uint32_t max_leaf_size) {
+  EmbreeBuildOptions options;
+  options.quality = EmbreeQuality::Medium;
+  options.max_leaf_size = max_leaf_size;
+  options.max_branching = 8;
+  options.traversal_cost = 1.0f;
+  options.intersection_cost = 1.0f;
+  options.sah_block_size = 4;
+  options.min_leaf_size = 4;
+  return options;
+}
+
 Bvh build_embree(const PrimitiveSet& prims, const EmbreeBuildOptions& options, BuildInfo* info) {
   auto t = std::chrono::steady_clock::now();
   std::vector<RTCBuildPrimitive> input(prims.size());
@@ -125,7 +138,10 @@ Bvh build_embree(const PrimitiveSet& prims, const EmbreeBuildOptions& options, B
   args.maxDepth = 1024;
   // Embree's Morton (LOW) builder makes leaves only at minLeafSize and ignores the costs;
   // its SAH builders take any size from 1 to maxLeafSize when a leaf is cheaper.
-  args.minLeafSize = options.quality == EmbreeQuality::Low ? options.max_leaf_size : 1;
+  args.minLeafSize = options.min_leaf_size != 0               ? std::min(options.min_leaf_size, options.max_leaf_size)
+                     : options.quality == EmbreeQuality::Low ? options.max_leaf_size
+                                                             : 1;
+  args.sahBlockSize = options.sah_block_size;
   args.maxLeafSize = options.max_leaf_size;
   args.traversalCost = options.traversal_cost;
   args.intersectionCost = options.intersection_cost;

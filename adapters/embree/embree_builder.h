@@ -19,7 +19,16 @@ struct EmbreeBuildOptions {
   uint32_t max_branching = 2;
   float traversal_cost = 3.0f;     // Embree's SAH constants, set to kmbvh's k_T and k_I so
   float intersection_cost = 2.0f;  // that Embree optimises the cost kmbvh reports
+  uint32_t sah_block_size = 1;     // leaves cost by blocks of this many primitives
+  uint32_t min_leaf_size = 0;      // 0: Embree's Morton builder max_leaf_size, the others 1
 };
+
+// The settings Embree's own scene builder uses for its default BVH (BVH8 of Triangle4
+// leaves, binned SAH at medium quality): eight children a node, leaves costed by blocks of
+// four triangles, traversal and intersection costs 1, a node of four triangles or fewer a
+// leaf. Built through rtcBuildBVH, so kmbvh's traversal can be measured over the tree shape
+// Embree's traversal runs on (the `embree-bvh8` builder).
+EmbreeBuildOptions embree_scene_bvh8_options(uint32_t max_leaf_size);
 
 // Throws std::runtime_error with Embree's message when the build fails.
 //

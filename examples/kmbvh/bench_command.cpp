@@ -19,7 +19,7 @@ void add_bench_command(CLI::App& app, BenchCommand& c) {
                   "scene files or names in $KMBVH_SCENES; 'default' is the embedded scene "
                   "(default: sponza_dabrovic sibenik conference)");
   cmd->add_option("--builders", c.builders,
-                  "comma-separated builders (sweep-sah, lbvh, hlbvh, atrbvh, ploc, Q1..Q5, QA, Q1S..Q5S, QAS, Q1R..Q5R, QAR, G before S, R or alone (Q2GS), embree-low|medium|high), "
+                  "comma-separated builders (sweep-sah, lbvh, hlbvh, atrbvh, ploc, Q1..Q5, QA, Q1S..Q5S, QAS, Q1R..Q5R, QAR, G before S, R or alone (Q2GS), embree-low|medium|high|bvh8), "
                   "or all");
   add_reference_options(*cmd, c.options);
   cmd->add_option("--reference", c.reference, "the builder build-time ratios are taken against");

@@ -50,7 +50,7 @@ void add_run_options(CLI::App& cmd, RunOptions& run) {
 void add_builder_options(CLI::App& cmd, BuilderOptions& b) {
   cmd.add_option("--builder", b.builder,
                   "sweep-sah, lbvh, hlbvh, atrbvh, ploc, kmeans (or Q1..Q5, QA; Q1S..Q5S, QAS: with SAH leaves; Q1R..Q5R, QAR: treelets restructured; a G before the S or R or alone, Q2G, Q2GS: seeded from cells), embree-low, "
-                  "embree-medium, embree-high");
+                  "embree-medium, embree-high, embree-bvh8 (Embree's scene-BVH settings: 8 children a node, leaves priced in blocks of four)");
   cmd.add_option("--preset", b.preset, "k-means preset Q1..Q5 (the paper's) or QA (adaptive); followed by S (Q3S): with SAH leaves; by R (Q3R): treelets restructured; a G first (Q3G, Q3GS): seeded from cells");
   b.k_opt = cmd.add_option("--k", b.k, "k-means: clusters per node (2..64)");
   b.p_opt = cmd.add_option("--p", b.p, "k-means: candidates per representative");
