@@ -188,7 +188,7 @@ Bvh run_builder(const BuilderConfig& config, const PrimitiveSet& prims, BuildInf
 ValidationLimits validation_limits(const BuilderConfig& config) {
   ValidationLimits limits;
   limits.max_leaf_size = config.max_leaf_size;
-  limits.max_arity = config.builder == BuilderKind::EmbreeBvh8                     ? 8
+  limits.max_arity = config.builder == BuilderKind::EmbreeBvh8 ? embree_scene_bvh8_options(config.max_leaf_size).max_branching
                      : (config.builder == BuilderKind::Kmeans && config.kmeans.wide) ? config.kmeans.k
                                                                                       : 2;
   return limits;
