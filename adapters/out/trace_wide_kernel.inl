@@ -133,33 +133,37 @@ struct RaySetup {
 // are measured with (inv_exit): a far plane's t is then larger in magnitude by the factor,
 // less the one rounding of the product, which the factor's margin over 1 + 2 gamma(3)
 // covers; the widening is off the node test's chain of dependent operations.
+// Named members, not arrays indexed by axis: GCC kept arrays of the struct in memory, so
+// every origin, reciprocal and plane offset of the node test was a stack load (2026-12-06,
+// AVX2 machine: all but tnear); as scalars the origins and offsets stay in registers.
 template <int W>
 struct WideRay {
   using V = typename Lanes<W>::V;
-  V org[3], inv[3], inv_exit[3], tnear;
-  int near_plane[3], far_plane[3];
-  __attribute__((always_inline)) WideRay(const Ray& ray, const RaySetup& s) {
-    for (int d = 0; d < 3; ++d) {
-      org[d] = splat<V>(ray.org[d]);
-      inv[d] = splat<V>(s.inv[d]);
-      inv_exit[d] = splat<V>(s.inv[d] * kRobustExit);
-      const bool near_hi = s.inv[d] < 0.0f;
-      near_plane[d] = (near_hi ? 3 * W : 0) + d * W;  // hi follows lo in WideNode
-      far_plane[d] = (near_hi ? 0 : 3 * W) + d * W;
-    }
-    tnear = splat<V>(ray.tnear);
-  }
+  V org_x, org_y, org_z, inv_x, inv_y, inv_z, exit_x, exit_y, exit_z, tnear;
+  int near_x, near_y, near_z, far_x, far_y, far_z;
+  __attribute__((always_inline)) WideRay(const Ray& ray, const RaySetup& s)
+      : org_x(splat<V>(ray.org.x)), org_y(splat<V>(ray.org.y)), org_z(splat<V>(ray.org.z)),
+        inv_x(splat<V>(s.inv[0])), inv_y(splat<V>(s.inv[1])), inv_z(splat<V>(s.inv[2])),
+        exit_x(splat<V>(s.inv[0] * kRobustExit)), exit_y(splat<V>(s.inv[1] * kRobustExit)),
+        exit_z(splat<V>(s.inv[2] * kRobustExit)), tnear(splat<V>(ray.tnear)),
+        near_x(near_plane(s.inv[0], 0)), near_y(near_plane(s.inv[1], 1)), near_z(near_plane(s.inv[2], 2)),
+        far_x(far_plane(s.inv[0], 0)), far_y(far_plane(s.inv[1], 1)), far_z(far_plane(s.inv[2], 2)) {}
+  // hi follows lo in WideNode
+  static int near_plane(float inv, int d) { return (inv < 0.0f ? 3 * W : 0) + d * W; }
+  static int far_plane(float inv, int d) { return (inv < 0.0f ? 0 : 3 * W) + d * W; }
 };
 
 template <int W>
-inline unsigned enter_children(const WideNode<W>& n, const WideRay<W>& r, float tmax, typename Lanes<W>::V& entry) {
+__attribute__((always_inline)) inline unsigned enter_children(const WideNode<W>& n, const WideRay<W>& r, float tmax,
+                                                              typename Lanes<W>::V& entry) {
   using V = typename Lanes<W>::V;
   const float* planes = &n.lo[0][0];
-  V t0 = r.tnear, t1 = splat<V>(tmax * kRobustExit);
-  for (int d = 0; d < 3; ++d) {
-    t0 = vmax(t0, (load<W>(planes + r.near_plane[d]) - r.org[d]) * r.inv[d]);
-    t1 = vmin(t1, (load<W>(planes + r.far_plane[d]) - r.org[d]) * r.inv_exit[d]);
-  }
+  V t0 = vmax(r.tnear, (load<W>(planes + r.near_x) - r.org_x) * r.inv_x);
+  V t1 = vmin(splat<V>(tmax * kRobustExit), (load<W>(planes + r.far_x) - r.org_x) * r.exit_x);
+  t0 = vmax(t0, (load<W>(planes + r.near_y) - r.org_y) * r.inv_y);
+  t1 = vmin(t1, (load<W>(planes + r.far_y) - r.org_y) * r.exit_y);
+  t0 = vmax(t0, (load<W>(planes + r.near_z) - r.org_z) * r.inv_z);
+  t1 = vmin(t1, (load<W>(planes + r.far_z) - r.org_z) * r.exit_z);
   entry = t0;
   return less_equal_bits(t0, t1);
 }
@@ -546,6 +550,18 @@ __attribute__((always_inline)) inline bool descend(const WideBvh<W>& bvh, const 
         continue;
       }
       // Several: the nearest is taken next, the others go on the stack farthest first.
+      // Two: one comparison in registers (Embree's two-hit case), where the
+      // insertion below goes through an array (the same order: of equals, the later lane).
+      if ((mask & (mask - 1)) == 0) {
+        const int other = __builtin_ctz(mask);
+        const bool first_nearer = entry[lane] < entry[other];
+        const int near = first_nearer ? lane : other, far = first_nearer ? other : lane;
+        stack[sp++] = WideEntry{n.ref[far], n.count[far], entry[far]};
+        prefetch_child(bvh, n.ref[far], n.count[far]);
+        cur = WideEntry{n.ref[near], n.count[near], entry[near]};
+        prefetch_child(bvh, cur.ref, cur.count);
+        continue;
+      }
       WideEntry hits[W];
       hits[0] = WideEntry{n.ref[lane], n.count[lane], entry[lane]};
       prefetch_child(bvh, hits[0].ref, hits[0].count);
