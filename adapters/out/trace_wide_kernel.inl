@@ -130,9 +130,9 @@ struct RaySetup {
 // Per-ray constants of the slab test, broadcast to every lane; the near and far planes of
 // each axis as offsets into a node's lo/hi arrays, chosen once by the direction's signs.
 // The exit distances are widened by kRobustExit (ray_box.h) through the reciprocals they
-// are measured with (inv_exit): a far plane's t is then larger in magnitude by the factor,
-// less the one rounding of the product, which the factor's margin over 1 + 2 gamma(3)
-// covers; the widening is off the node test's chain of dependent operations.
+// are measured with (exit_x, exit_y, exit_z): a far plane's t is then larger in magnitude
+// by the factor, less the one rounding of the product, which the factor's margin over
+// 1 + 2 gamma(3) covers; the widening is off the node test's chain of dependent operations.
 // Named members, not arrays indexed by axis: GCC kept arrays of the struct in memory, so
 // every origin, reciprocal and plane offset of the node test was a stack load (2026-12-06,
 // AVX2 machine: all but tnear); as scalars the origins and offsets stay in registers.
