@@ -87,25 +87,31 @@ void SceneAccel::set_filters(std::vector<GeometryFilters> filters) {
   }
 }
 
-SceneAccel::SceneAccel(const std::vector<EmbreeTriangleMesh>& meshes, std::vector<GeometryFilters> filters,
-                       RTCBuildQuality quality, AccelReport& report, BuildContext* context, bool refittable,
-                       SceneAccel* previous) {
+CommitMeshes::CommitMeshes(const std::vector<EmbreeTriangleMesh>& meshes_in) : meshes(meshes_in.size()) {
+  const auto start = std::chrono::steady_clock::now();
+  flat = flatten_triangle_meshes(meshes_in);
+  if (!flat.scene.triangles.empty()) prims = make_primitive_set(flat.scene);
+  ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
+}
+
+SceneAccel::SceneAccel(CommitMeshes input, std::vector<GeometryFilters> filters, RTCBuildQuality quality,
+                       AccelReport& report, BuildContext* context, bool refittable, SceneAccel* previous) {
   set_filters(std::move(filters));
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
-  FlattenedMeshes flat = flatten_triangle_meshes(meshes);
+  FlattenedMeshes& flat = input.flat;
   const BuilderConfig config = builder_for(plugin_config(), quality);
   report.builder = config.label();
-  report.meshes = meshes.size();
+  report.meshes = input.meshes;
   report.dropped = flat.dropped;
   report.triangles = flat.scene.triangles.size();
   report.isa = to_string(traversal_isa());  // a KMBVH_ISA this CPU cannot run fails here, before the build
   if (!flat.scene.triangles.empty()) {  // else every ray misses
-    const PrimitiveSet prims = make_primitive_set(flat.scene);
+    const PrimitiveSet& prims = input.prims;
     BuildInfo info;
     Bvh bvh = run_builder(config, prims, &info, context);
     report.allocations = info.backend.allocations;
-    report.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+    report.build_ms = input.ms + std::chrono::duration<double, std::milli>(Clock::now() - start).count();
     report.sah = sah_cost(bvh);
     tracer_ = std::make_unique<Tracer>(bvh, prims, flat.scene, Layout::Bvh8, Backend::Cpu, &flat.ids,
                                        previous ? previous->tracer_.get() : nullptr);
@@ -116,15 +122,15 @@ SceneAccel::SceneAccel(const std::vector<EmbreeTriangleMesh>& meshes, std::vecto
   if (plugin_config().ab.on) geometry_ = std::make_unique<AccelGeometry>(std::move(flat));
 }
 
-bool SceneAccel::refit(const std::vector<EmbreeTriangleMesh>& meshes, std::vector<GeometryFilters> filters,
-                       AccelReport& report, std::string& why) {
+bool SceneAccel::refit(CommitMeshes& input, std::vector<GeometryFilters> filters, AccelReport& report,
+                       std::string& why) {
   if (!refit_base_) {
     why = "no tree kept";
     return false;
   }
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
-  FlattenedMeshes flat = flatten_triangle_meshes(meshes);
+  const FlattenedMeshes& flat = input.flat;
   RefitBase& base = *refit_base_;
   // The same triangles: the same vertex indices, and the same ones kept (a vertex that
   // became non-finite drops its triangles, as Embree's commit does).
@@ -134,7 +140,7 @@ bool SceneAccel::refit(const std::vector<EmbreeTriangleMesh>& meshes, std::vecto
     why = "its triangles changed";
     return false;
   }
-  const PrimitiveSet prims = make_primitive_set(flat.scene);
+  const PrimitiveSet& prims = input.prims;
   if (prims.size() != base.bvh.prim_indices.size()) {  // flattening keeps finite triangles only: never, but cheap
     why = "its primitives changed";
     return false;
@@ -148,16 +154,17 @@ bool SceneAccel::refit(const std::vector<EmbreeTriangleMesh>& meshes, std::vecto
     return false;
   }
   report.builder = "refit of " + base.builder;
-  report.meshes = meshes.size();
+  report.meshes = input.meshes;
   report.dropped = flat.dropped;
   report.triangles = flat.scene.triangles.size();
   report.isa = to_string(traversal_isa());
   report.sah = sah;
-  report.build_ms = std::chrono::duration<double, std::milli>(Clock::now() - start).count();
+  report.build_ms = input.ms + std::chrono::duration<double, std::milli>(Clock::now() - start).count();
   auto tracer = std::make_unique<Tracer>(base.bvh, prims, flat.scene, Layout::Bvh8, Backend::Cpu, &flat.ids,
                                          tracer_.get());
   report.layout_ms = tracer->layout_ms();
-  std::unique_ptr<AccelGeometry> geometry = geometry_ ? std::make_unique<AccelGeometry>(std::move(flat)) : nullptr;
+  std::unique_ptr<AccelGeometry> geometry =
+      geometry_ ? std::make_unique<AccelGeometry>(std::move(input.flat)) : nullptr;
   // Nothing throws past here. (The new layout has the old one's memory already: a throw
   // above leaves this tree answering misses until the caller builds the scene again.)
   tracer_ = std::move(tracer);

@@ -56,18 +56,29 @@ struct AccelGeometry {
   }
 };
 
+// One commit's meshes, flattened (their triangles in one array) and made build primitives,
+// once: a dynamic scene's commit tries a refit with them and, where the refit is refused,
+// builds from them, instead of reading the meshes again. Throws as flatten_triangle_meshes
+// does (UnsupportedMesh): the caller lets Embree answer for the scene.
+struct CommitMeshes {
+  FlattenedMeshes flat;
+  PrimitiveSet prims;
+  size_t meshes = 0;
+  double ms = 0;  // what making them took, counted in the build's or the refit's time
+  explicit CommitMeshes(const std::vector<EmbreeTriangleMesh>& meshes);
+};
+
 class SceneAccel {
  public:
-  // filters: by geomID (empty: none). Throws (std::exception) when the meshes cannot be
-  // read or the build fails: the caller lets Embree answer for the scene. `context`: the
+  // filters: by geomID (empty: none). Throws (std::exception) when the build fails: the
+  // caller lets Embree answer for the scene. `context`: the
   // scene's build memory, kept from one commit to the next (may be null).
   // `refittable`: the scene is dynamic, and the tree is kept for refit(). `previous`: the
   // scene's tree until this commit, never traced again (Embree's rule: no trace during a
   // commit), whose layout memory the new layout takes over (Tracer's reuse), so a scene
   // committed again and again does not fault in fresh pages for every layout.
-  SceneAccel(const std::vector<EmbreeTriangleMesh>& meshes, std::vector<GeometryFilters> filters,
-             RTCBuildQuality quality, AccelReport& report, BuildContext* context = nullptr, bool refittable = false,
-             SceneAccel* previous = nullptr);
+  SceneAccel(CommitMeshes input, std::vector<GeometryFilters> filters, RTCBuildQuality quality, AccelReport& report,
+             BuildContext* context = nullptr, bool refittable = false, SceneAccel* previous = nullptr);
   ~SceneAccel();
 
   // A dynamic scene's commit after its vertices moved (rtcUpdateGeometryBuffer), its
@@ -78,9 +89,8 @@ class SceneAccel {
   // pays). Not during traces (Embree's rule for a commit). Throws as the constructor does;
   // the new layout is made in the old one's memory, so after a throw this tree answers every
   // ray with a miss until the caller builds the scene again.
-  // `why`: the reason, where it returns false.
-  bool refit(const std::vector<EmbreeTriangleMesh>& meshes, std::vector<GeometryFilters> filters,
-             AccelReport& report, std::string& why);
+  // `why`: the reason, where it returns false; `input` is then as it was, for a build.
+  bool refit(CommitMeshes& input, std::vector<GeometryFilters> filters, AccelReport& report, std::string& why);
   static constexpr double kRefitSahLimit = 1.25;
 
   // Whether some geometry has a filter for this query (most scenes: none, and the

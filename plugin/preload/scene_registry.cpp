@@ -474,15 +474,24 @@ void commit_or_build(RTCScene scene, bool join) {
     return;
   }
 
+  // The meshes read once, for a refit and, where it is refused, the build (CommitMeshes).
+  std::unique_ptr<CommitMeshes> input;
+  try {
+    input = std::make_unique<CommitMeshes>(meshes);
+  } catch (const std::exception& e) {
+    return commit_by_embree(scene, *s, join, std::string("kmbvh could not build it: ") + e.what(), instanced);
+  }
+
   // A dynamic scene whose vertices moved: the tree refitted, where that does (SceneAccel::refit).
   if (refittable) {
     AccelReport report;
     bool refitted = false;
     std::string why;
     try {
-      refitted = s->owned->refit(meshes, filters, report, why);
+      refitted = s->owned->refit(*input, filters, report, why);
     } catch (const std::exception& e) {
       why = e.what();  // a rebuild tries, and reports what fails
+      input.reset();   // which the failed refit may have taken from: read again below
     }
     if (!refitted && plugin_config().log)
       log_line(fmt::format("scene {}: built again, not refitted: {}", static_cast<void*>(scene), why));
@@ -499,8 +508,9 @@ void commit_or_build(RTCScene scene, bool join) {
   std::unique_ptr<SceneAccel> accel;
   AccelReport report;
   try {
-    accel = std::make_unique<SceneAccel>(meshes, std::move(filters), quality, report, &s->build_context, dynamic,
-                                         s->owned.get());
+    if (!input) input = std::make_unique<CommitMeshes>(meshes);
+    accel = std::make_unique<SceneAccel>(std::move(*input), std::move(filters), quality, report, &s->build_context,
+                                         dynamic, s->owned.get());
   } catch (const std::exception& e) {
     return commit_by_embree(scene, *s, join, std::string("kmbvh could not build it: ") + e.what(), instanced);
   }
