@@ -71,12 +71,12 @@ struct CommitMeshes {
 class SceneAccel {
  public:
   // filters: by geomID (empty: none). Throws (std::exception) when the build fails: the
-  // caller lets Embree answer for the scene. `context`: the
-  // scene's build memory, kept from one commit to the next (may be null).
-  // `refittable`: the scene is dynamic, and the tree is kept for refit(). `previous`: the
-  // scene's tree until this commit, never traced again (Embree's rule: no trace during a
-  // commit), whose layout memory the new layout takes over (Tracer's reuse), so a scene
-  // committed again and again does not fault in fresh pages for every layout.
+  // caller lets Embree answer for the scene. `context`: the scene's build memory, kept from
+  // one commit to the next (may be null). `refittable`: the scene is dynamic, and the tree
+  // is kept for refit(). `previous`: the scene's tree until this commit, never traced again
+  // (Embree's rule: no trace during a commit), whose layout memory the new layout takes
+  // over (Tracer's reuse), so a scene committed again and again does not fault in fresh
+  // pages for every layout.
   SceneAccel(CommitMeshes input, std::vector<GeometryFilters> filters, RTCBuildQuality quality, AccelReport& report,
              BuildContext* context = nullptr, bool refittable = false, SceneAccel* previous = nullptr);
   ~SceneAccel();
