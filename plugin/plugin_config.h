@@ -45,6 +45,7 @@ struct PluginConfig {
   AbConfig ab;
   std::string record_rays;  // KMBVH_RECORD_RAYS: the file, or empty
   uint32_t record_limit = 2000000;
+  bool mesh_trees = true;  // KMBVH_MESH_TREES=0: a dynamic scene's meshes under one tree (scene_accel.h)
 };
 
 // Throws std::invalid_argument naming the variable and its bad value.

@@ -544,6 +544,25 @@ TEST(Traversal, LayoutInAnEarlierLayoutsMemoryIsTheFreshLayout) {
   EXPECT_EQ(a.t, b.t);
 }
 
+// A scene committed again with a few more packs (a dynamic scene's rebuilt tree) is laid out
+// in the earlier layout's memory: its arrays were reserved with room to spare
+// (layout_memory.h, reserve_with_headroom), so 59 MB of packs are not moved to fresh pages.
+TEST(Traversal, LayoutAFewPacksLargerStaysInTheEarlierMemory) {
+  const TriangleScene first = test::random_triangles(6000, 42), second = test::random_triangles(6300, 43);
+  const PrimitiveSet first_prims = make_primitive_set(first), second_prims = make_primitive_set(second);
+  const Bvh first_tree = run_builder(parse_builder("Q1"), first_prims);
+  const Bvh second_tree = run_builder(parse_builder("Q1"), second_prims);
+  WideBvh<8> earlier = lay_out_wide<8>(first_tree, first_prims, first, true);
+  const size_t packs = earlier.packs.size();
+  const TrianglePack* memory = earlier.packs.data();
+  const WideBvh<8> fresh = lay_out_wide<8>(second_tree, second_prims, second, true);
+  ASSERT_GT(fresh.packs.size(), packs);  // the case: more packs than the earlier layout used,
+  ASSERT_LE(fresh.packs.size(), packs + packs / 8);  // within the headroom
+  const WideBvh<8> again = lay_out_wide<8>(second_tree, second_prims, second, true, nullptr, &earlier);
+  EXPECT_EQ(again.packs.data(), memory);
+  expect_same_layout(again, fresh, "a few packs larger, in the earlier layout's memory");
+}
+
 TEST(Traversal, OnePassLayoutRefusesWhatDoesNotFit) {
   const TriangleScene scene = test::random_triangles(1000, 38);
   const PrimitiveSet prims = make_primitive_set(scene);

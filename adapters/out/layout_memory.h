@@ -71,4 +71,14 @@ struct LayoutAllocator {
 template <typename T>
 using LayoutArray = std::vector<T, LayoutAllocator<T>>;
 
+// Room for n elements; where the array must move to find it, room for an eighth more. A
+// layout made in an earlier layout's memory (a scene committed again) needs a few more nodes
+// or packs when the new tree's leaves differ, and moving 59 MB of packs to fresh memory
+// faulted all of it in again (dynamic_scene's second commit); the headroom is address
+// space, faulted in only where a later layout writes it.
+template <typename T>
+void reserve_with_headroom(LayoutArray<T>& v, size_t n) {
+  if (n > v.capacity()) v.reserve(n + n / 8);
+}
+
 }  // namespace kmbvh

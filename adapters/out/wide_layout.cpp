@@ -54,7 +54,7 @@ Plan<W> plan_layout(const Bvh& bvh, bool collapse, LayoutArray<WideNode<W>> node
   Plan<W> plan;
   plan.out.nodes = std::move(nodes);
   plan.out.nodes.clear();  // keeps its memory
-  plan.out.nodes.reserve(bvh.nodes.size() / 2 + 1);  // a wide node per interior node at most: never grown
+  reserve_with_headroom(plan.out.nodes, bvh.nodes.size() / 2 + 1);  // a wide node per interior node at most: never grown
   plan.leaves.reserve(bvh.nodes.size() / 2 + 1);
   if (bvh.root().is_leaf()) {  // one leaf: a root with a single lane
     plan.out.nodes.push_back(empty_wide_node<W>());
@@ -198,7 +198,9 @@ WideBvh<W> lay_out_wide(const Bvh& bvh, const PrimitiveSet& prims, const Triangl
     packs.clear();
   }
   const size_t touched = packs.capacity();  // pages a previous layout wrote: no fault to take
-  packs.resize(count_packs(bvh));  // not zeroed (layout_memory.h): fill_leaf writes each pack whole
+  const uint32_t pack_count = count_packs(bvh);
+  reserve_with_headroom(packs, pack_count);
+  packs.resize(pack_count);  // not zeroed (layout_memory.h): fill_leaf writes each pack whole
   Plan<W> plan;
   ParallelErrors errors;
 #pragma omp parallel

@@ -13,5 +13,8 @@ namespace kmbvh {
 // last node to the root does it. `prims` holds the primitives the tree was built over, in
 // the same order, their boxes moved.
 void refit_in_place(Bvh& bvh, const PrimitiveSet& prims);
+// The same with the primitives' boxes given as an array: boxes[i] for the tree's primitive
+// i (a group's tree over a part of a set: grouped_build.h).
+void refit_in_place(Bvh& bvh, const Aabb* boxes);
 
 }  // namespace kmbvh

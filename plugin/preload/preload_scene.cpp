@@ -162,6 +162,11 @@ KMBVH_EXPORT void rtcSetGeometryMask(RTCGeometry geometry, unsigned int mask) {
   track([&] { track_mask(geometry, mask); });
 }
 
+KMBVH_EXPORT void rtcSetGeometryBuildQuality(RTCGeometry geometry, RTCBuildQuality quality) {
+  KMBVH_REAL_EMBREE(rtcSetGeometryBuildQuality)(geometry, quality);
+  track([&] { track_build_quality(geometry, quality); });
+}
+
 KMBVH_EXPORT void rtcSetGeometryIntersectFilterFunction(RTCGeometry geometry, RTCFilterFunctionN filter) {
   KMBVH_REAL_EMBREE(rtcSetGeometryIntersectFilterFunction)(geometry, filter);
   track([&] { track_filter(geometry, false, filter); });

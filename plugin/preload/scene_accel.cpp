@@ -109,21 +109,34 @@ SceneAccel::SceneAccel(CommitMeshes input, std::vector<GeometryFilters> filters,
   if (!flat.scene.triangles.empty()) {  // else every ray misses
     const PrimitiveSet& prims = input.prims;
     BuildInfo info;
-    Bvh bvh = run_builder(config, prims, &info, context);
+    Bvh bvh;
+    if (refittable) {
+      refit_base_ = std::make_unique<RefitBase>();
+      RefitBase& base = *refit_base_;
+      std::vector<uint32_t> meshes = groups_by_geometry(flat.ids);
+      if (meshes.size() > kMaxMeshTrees || !plugin_config().mesh_trees) meshes.assign(1, 0);
+      if (meshes.size() > 1) report.builder += fmt::format(", a tree per mesh ({})", meshes.size());
+      base.trees = build_grouped(config, prims, meshes, &info, context);
+      base.join();
+      base.triangles = flat.scene.triangles;
+      base.ids = flat.ids;
+      base.config = config;
+    } else {
+      bvh = run_builder(config, prims, &info, context);
+    }
+    const Bvh& traced = refittable ? refit_base_->traced() : bvh;
     report.allocations = info.backend.allocations;
     report.build_ms = input.ms + std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-    report.sah = sah_cost(bvh);
-    tracer_ = std::make_unique<Tracer>(bvh, prims, flat.scene, Layout::Bvh8, Backend::Cpu, &flat.ids,
+    report.sah = sah_cost(traced);
+    tracer_ = std::make_unique<Tracer>(traced, prims, flat.scene, Layout::Bvh8, Backend::Cpu, &flat.ids,
                                        previous ? previous->tracer_.get() : nullptr);
     report.layout_ms = tracer_->layout_ms();
-    if (refittable)
-      refit_base_.reset(new RefitBase{std::move(bvh), flat.scene.triangles, flat.ids, report.sah, report.builder});
   }
   if (plugin_config().ab.on) geometry_ = std::make_unique<AccelGeometry>(std::move(flat));
 }
 
-bool SceneAccel::refit(CommitMeshes& input, std::vector<GeometryFilters> filters, AccelReport& report,
-                       std::string& why) {
+bool SceneAccel::refit(CommitMeshes& input, std::vector<GeometryFilters> filters, const std::vector<bool>& refit_meshes,
+                       AccelReport& report, std::string& why, BuildContext* context) {
   if (!refit_base_) {
     why = "no tree kept";
     return false;
@@ -141,26 +154,42 @@ bool SceneAccel::refit(CommitMeshes& input, std::vector<GeometryFilters> filters
     return false;
   }
   const PrimitiveSet& prims = input.prims;
-  if (prims.size() != base.bvh.prim_indices.size()) {  // flattening keeps finite triangles only: never, but cheap
+  if (prims.size() != base.triangles.size()) {  // flattening keeps finite triangles only: never, but cheap
     why = "its primitives changed";
     return false;
   }
   // In place: what is traced is the layout, made below, and every refit recomputes every
   // box, so a refit refused here leaves nothing behind that matters.
-  refit_in_place(base.bvh, prims);
-  const double sah = sah_cost(base.bvh);
-  if (!(sah <= kRefitSahLimit * base.built_sah)) {
-    why = fmt::format("a refit's SAH {:.2f} is above {} times the build's {:.2f}", sah, kRefitSahLimit, base.built_sah);
-    return false;
+  GroupedBvh& trees = base.trees;
+  size_t rebuilt = 0;
+  BuildInfo info;
+  for (size_t g = 0; g < trees.groups(); ++g) {
+    refit_in_place(trees.trees[g], prims.boxes.data() + trees.first[g]);
+    const uint32_t geom = flat.ids[trees.first[g]].geom;
+    if (trees.groups() > 1 && geom < refit_meshes.size() && refit_meshes[geom]) continue;  // as asked
+    const double sah = sah_cost(trees.trees[g]);
+    if (sah <= kRefitSahLimit * trees.built_sah[g]) continue;
+    if (trees.groups() == 1) {
+      why = fmt::format("a refit's SAH {:.2f} is above {} times the build's {:.2f}", sah, kRefitSahLimit,
+                        trees.built_sah[g]);
+      return false;
+    }
+    rebuild_group(trees, g, base.config, prims, &info, context);
+    ++rebuilt;
   }
-  report.builder = "refit of " + base.builder;
+  base.join();
+  const Bvh& traced = base.traced();
+  report.builder = "refit of " + base.config.label();
+  if (trees.groups() > 1)
+    report.builder += fmt::format(" ({} of {} meshes; {} built again)", trees.groups() - rebuilt, trees.groups(), rebuilt);
   report.meshes = input.meshes;
   report.dropped = flat.dropped;
   report.triangles = flat.scene.triangles.size();
   report.isa = to_string(traversal_isa());
-  report.sah = sah;
+  report.sah = sah_cost(traced);
+  report.allocations = info.backend.allocations;
   report.build_ms = input.ms + std::chrono::duration<double, std::milli>(Clock::now() - start).count();
-  auto tracer = std::make_unique<Tracer>(base.bvh, prims, flat.scene, Layout::Bvh8, Backend::Cpu, &flat.ids,
+  auto tracer = std::make_unique<Tracer>(traced, prims, flat.scene, Layout::Bvh8, Backend::Cpu, &flat.ids,
                                          tracer_.get());
   report.layout_ms = tracer->layout_ms();
   std::unique_ptr<AccelGeometry> geometry =

@@ -11,6 +11,7 @@
 #include <vector>
 
 #include "adapters/embree/embree_geometry.h"
+#include "adapters/grouped_build.h"
 #include "adapters/out/tracer.h"
 #include "cuda/core/build_context.h"
 #include "ray_recorder.h"
@@ -82,16 +83,25 @@ class SceneAccel {
   ~SceneAccel();
 
   // A dynamic scene's commit after its vertices moved (rtcUpdateGeometryBuffer), its
-  // triangles the same: the kept tree's boxes are refitted to the new vertices bottom-up and
-  // laid out again, with no build. Returns false, changing nothing that is traced, where it
-  // cannot: no tree kept, triangles added, dropped or re-indexed, or a refitted tree whose SAH
-  // cost is above kRefitSahLimit times the build's (the motion has spoilt it: a rebuild
-  // pays). Not during traces (Embree's rule for a commit). Throws as the constructor does;
+  // triangles the same: the kept trees' boxes are refitted to the new vertices bottom-up and
+  // laid out again. A scene of several meshes has a tree per mesh (kMaxMeshTrees), each
+  // refitted on its own: one whose refit costs more than kRefitSahLimit times its build's
+  // SAH (the motion has spoilt it) is built again, unless the application asked for refits
+  // of it (`refit_meshes[geomID]`: RTC_BUILD_QUALITY_REFIT, which Embree refits whatever
+  // the motion did); then only the top tree over the meshes is built anew. `context`: the
+  // scene's build memory, for those builds. Returns false, changing nothing that is traced,
+  // where it cannot: no tree kept, triangles added, dropped or re-indexed, or a single
+  // tree whose refit is spoilt (a rebuild of the scene pays). Not during traces (Embree's rule for a commit). Throws as the constructor does;
   // the new layout is made in the old one's memory, so after a throw this tree answers every
   // ray with a miss until the caller builds the scene again.
   // `why`: the reason, where it returns false; `input` is then as it was, for a build.
-  bool refit(CommitMeshes& input, std::vector<GeometryFilters> filters, AccelReport& report, std::string& why);
+  bool refit(CommitMeshes& input, std::vector<GeometryFilters> filters, const std::vector<bool>& refit_meshes,
+             AccelReport& report, std::string& why, BuildContext* context = nullptr);
   static constexpr double kRefitSahLimit = 1.25;
+  // A dynamic scene of 2 to kMaxMeshTrees meshes is built as Embree builds one, a tree per
+  // mesh under a top tree over the meshes (grouped_build.h); more are built as one tree,
+  // since each mesh's build has a cost of its own.
+  static constexpr size_t kMaxMeshTrees = 256;
 
   // Whether some geometry has a filter for this query (most scenes: none, and the
   // traversal runs without offering hits).
@@ -124,13 +134,19 @@ class SceneAccel {
   static bool offer(void* user, const Ray& ray, const Hit& offered);
   void set_filters(std::vector<GeometryFilters> filters);
 
-  // What a refit starts from: the tree as built, and the triangles and ids it was built over.
+  // What a refit starts from: the trees as built (a tree per mesh, or one), the tree the
+  // layout took (their join, kept for its memory), the triangles and ids they were built
+  // over, and the builder that built them.
   struct RefitBase {
-    Bvh bvh;
+    GroupedBvh trees;
+    Bvh joined;
     std::vector<Triangle> triangles;
     std::vector<PrimitiveId> ids;
-    double built_sah = 0;
-    std::string builder;
+    BuilderConfig config;
+    const Bvh& traced() const { return trees.groups() == 1 ? trees.trees[0] : joined; }
+    void join() {
+      if (trees.groups() > 1) join_groups(trees, joined);
+    }
   };
 
   std::unique_ptr<Tracer> tracer_;  // null: nothing to hit

@@ -29,6 +29,7 @@ struct GeometryRecord {
   bool enabled = true, committed = false;
   RTCFilterFunctionN intersect_filter = nullptr, occluded_filter = nullptr;
   unsigned mask = 0xFFFFFFFFu, time_steps = 1;
+  RTCBuildQuality quality = RTC_BUILD_QUALITY_MEDIUM;  // rtcSetGeometryBuildQuality's
   RTCScene instanced = nullptr;  // an instance's scene
   EmbreeBufferView vertices, indices;  // slot 0 of each
   uint64_t version = 0;  // counts changes, so an unchanged scene is not built again
@@ -152,10 +153,12 @@ const char* type_name(RTCGeometryType type) {
 constexpr unsigned kMaxFilteredGeomId = 1u << 20;
 
 // Why kmbvh cannot answer the scene ("" when it can); fills the meshes kmbvh would read,
-// their filter functions by geomID, and the scenes instanced by the scene's instances
+// their filter functions by geomID, which of them the application wants refitted
+// (RTC_BUILD_QUALITY_REFIT) by geomID, and the scenes instanced by the scene's instances
 // (Embree must have them committed).
 std::string unsupported_reason(const SceneRecord& s, std::vector<EmbreeTriangleMesh>& meshes,
-                               std::vector<GeometryFilters>& filters, std::vector<RTCScene>& instanced) {
+                               std::vector<GeometryFilters>& filters, std::vector<bool>& refit_meshes,
+                               std::vector<RTCScene>& instanced) {
   std::string reason;
   const auto because = [&reason](std::string why) {
     if (reason.empty()) reason = std::move(why);
@@ -176,6 +179,10 @@ std::string unsupported_reason(const SceneRecord& s, std::vector<EmbreeTriangleM
       because(fmt::format("geometry {} was never committed", id));
     else
       meshes.push_back(EmbreeTriangleMesh{id, g->vertices, g->indices});
+    if (g->type == RTC_GEOMETRY_TYPE_TRIANGLE && g->quality == RTC_BUILD_QUALITY_REFIT && id < kMaxFilteredGeomId) {
+      if (refit_meshes.size() <= id) refit_meshes.resize(id + 1);
+      refit_meshes[id] = true;
+    }
     if (g->type == RTC_GEOMETRY_TYPE_TRIANGLE && (g->intersect_filter || g->occluded_filter) && id < kMaxFilteredGeomId) {
       if (filters.size() <= id) filters.resize(id + 1);
       filters[id] = GeometryFilters{g->intersect_filter, g->occluded_filter, g->handle};
@@ -319,6 +326,9 @@ void track_time_steps(RTCGeometry geometry, unsigned count) {
 void track_mask(RTCGeometry geometry, unsigned mask) {
   update_geometry(geometry, [mask](GeometryRecord& g) { g.mask = mask; });
 }
+void track_build_quality(RTCGeometry geometry, RTCBuildQuality quality) {
+  update_geometry(geometry, [quality](GeometryRecord& g) { g.quality = quality; });
+}
 void track_filter(RTCGeometry geometry, bool occluded, RTCFilterFunctionN filter) {
   update_geometry(geometry, [=](GeometryRecord& g) { (occluded ? g.occluded_filter : g.intersect_filter) = filter; });
 }
@@ -437,6 +447,7 @@ void commit_or_build(RTCScene scene, bool join) {
   SceneRecord* s = nullptr;
   std::vector<EmbreeTriangleMesh> meshes;
   std::vector<GeometryFilters> filters;
+  std::vector<bool> refit_meshes;
   std::vector<RTCScene> instanced;
   std::string reason;
   RTCBuildQuality quality = RTC_BUILD_QUALITY_MEDIUM;
@@ -447,7 +458,7 @@ void commit_or_build(RTCScene scene, bool join) {
     std::lock_guard<std::mutex> lock(r.mutex);
     s = scene_of(r, scene);
     if (s) {
-      reason = unsupported_reason(*s, meshes, filters, instanced);
+      reason = unsupported_reason(*s, meshes, filters, refit_meshes, instanced);
       quality = s->quality;
       embree_too = s->instanced;
       signature = scene_signature(*s);
@@ -488,7 +499,7 @@ void commit_or_build(RTCScene scene, bool join) {
     bool refitted = false;
     std::string why;
     try {
-      refitted = s->owned->refit(*input, filters, report, why);
+      refitted = s->owned->refit(*input, filters, refit_meshes, report, why, &s->build_context);
     } catch (const std::exception& e) {
       why = e.what();  // a rebuild tries, and reports what fails
       input.reset();   // which the failed refit may have taken from: read again below

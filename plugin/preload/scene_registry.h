@@ -32,6 +32,7 @@ void track_commit_geometry(RTCGeometry geometry);
 void track_enable_geometry(RTCGeometry geometry, bool enabled);
 void track_time_steps(RTCGeometry geometry, unsigned count);
 void track_mask(RTCGeometry geometry, unsigned mask);
+void track_build_quality(RTCGeometry geometry, RTCBuildQuality quality);
 void track_filter(RTCGeometry geometry, bool occluded, RTCFilterFunctionN filter);
 void track_instanced_scene(RTCGeometry geometry, RTCScene scene);
 // data: where element 0 starts (the byte offset applied); null when Embree refused it.

@@ -3,7 +3,8 @@
 #   kmbvh_run_alone_and_preloaded(<what> <ext> <command...>)
 # The command has @OUT@ where each run's output file goes: ${WORK}/embree.<ext>, then
 # ${WORK}/kmbvh.<ext>. Fails, naming <what>, when a run fails or the log has no ray counts;
-# sets preload_log, by_kmbvh and by_embree (rays each answered) in the caller.
+# sets preload_log, by_kmbvh and by_embree (rays each answered) in the caller. PRELOAD_ENV:
+# more VAR=value for the preloaded run.
 function(kmbvh_run_alone_and_preloaded what ext)
   file(MAKE_DIRECTORY "${WORK}")
   list(TRANSFORM ARGN REPLACE "^@OUT@$" "${WORK}/embree.${ext}" OUTPUT_VARIABLE alone)
@@ -12,7 +13,7 @@ function(kmbvh_run_alone_and_preloaded what ext)
   if(NOT rc EQUAL 0)
     message(FATAL_ERROR "${what} on Embree failed (${rc})")
   endif()
-  execute_process(COMMAND ${CMAKE_COMMAND} -E env "LD_PRELOAD=${PRELOAD}" KMBVH_LOG=1 ${preloaded}
+  execute_process(COMMAND ${CMAKE_COMMAND} -E env "LD_PRELOAD=${PRELOAD}" KMBVH_LOG=1 ${PRELOAD_ENV} ${preloaded}
                   RESULT_VARIABLE rc ERROR_VARIABLE log)
   message("${log}")
   if(NOT rc EQUAL 0)

@@ -21,7 +21,9 @@
 //           (rtcUpdateGeometryBuffer, rtcCommitGeometry) and the scene committed again, as
 //           an animation does: kmbvh refits its tree instead of building it again.
 // --scatter: as --dynamic, with the scene's parts also thrown pseudo-random distances, so
-//           the refitted tree is far worse than a new one and kmbvh builds the scene again.
+//           the refitted trees are far worse than new ones and kmbvh builds them again.
+// --refit-quality: every mesh asks for refits (RTC_BUILD_QUALITY_REFIT), which Embree and
+//           kmbvh then refit however the motion spoils them.
 #include <embree3/rtcore.h>
 #include <fmt/format.h>
 
@@ -63,7 +65,7 @@ constexpr int kFormCount = 8;
 
 struct Options {
   std::string scene;
-  bool filter = false, quad = false, exact_forms = false, dynamic = false, scatter = false;
+  bool filter = false, quad = false, exact_forms = false, dynamic = false, scatter = false, refit_quality = false;
 };
 
 // Where --dynamic moves a vertex: the scene grown by 1%, shifted along x and rippled in y,
@@ -159,6 +161,7 @@ RTCScene build_scene(RTCDevice device, const TriangleScene& scene, const Options
       rtcReleaseBuffer(vb);
       rtcReleaseBuffer(ib);
     }
+    if (o.refit_quality) rtcSetGeometryBuildQuality(g, RTC_BUILD_QUALITY_REFIT);
     rtcCommitGeometry(g);
     rtcAttachGeometry(s, g);
     rtcReleaseGeometry(g);
@@ -581,6 +584,7 @@ int main(int argc, char** argv) {
       else if (a == "--exact-forms") o.exact_forms = true;
       else if (a == "--dynamic") o.dynamic = true;
       else if (a == "--scatter") o.dynamic = o.scatter = true;
+      else if (a == "--refit-quality") o.refit_quality = true;
       else if (a.rfind("--", 0) == 0) throw std::invalid_argument("unknown option " + a);
       else files.push_back(a);
     }
