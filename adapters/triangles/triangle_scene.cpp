@@ -1,6 +1,7 @@
 #include "triangle_scene.h"
 
 #include <algorithm>
+#include <cstdint>
 #include <vector>
 
 #include "cuda/core/huge_pages.h"
@@ -42,17 +43,31 @@ void TriangleScene::add_triangle(Vec3 a, Vec3 b, Vec3 c) {
 }
 
 PrimitiveSet make_primitive_set(const TriangleScene& scene, size_t* dropped) {
-  PrimitiveSet set;
-  reserve_on_huge_pages(set.boxes, scene.size());
-  reserve_on_huge_pages(set.ids, scene.size());
-  size_t skipped = 0;
-  for (size_t t = 0; t < scene.size(); ++t) {
+  // Every triangle's box in one parallel pass (a scene commit makes the set for each build
+  // and refit: 1.14M triangles took 12 ms on one thread); the rare scene with non-finite
+  // vertices then has those triangles taken out, the others kept in order.
+  const size_t n = scene.size();
+  const auto finite = [&](size_t t) {
     const Triangle& v = scene.triangles[t];
-    if (!is_finite(scene.positions[v[0]]) || !is_finite(scene.positions[v[1]]) || !is_finite(scene.positions[v[2]])) {
-      ++skipped;
-      continue;
-    }
-    set.push_back(scene.triangle_box(t), PrimitiveId{0, static_cast<uint32_t>(t)});
+    return is_finite(scene.positions[v[0]]) && is_finite(scene.positions[v[1]]) && is_finite(scene.positions[v[2]]);
+  };
+  PrimitiveSet set;
+  grow_on_huge_pages(set.boxes, n);
+  grow_on_huge_pages(set.ids, n);
+  size_t skipped = 0;
+#pragma omp parallel for reduction(+ : skipped)
+  for (int64_t i = 0; i < int64_t(n); ++i) {
+    const auto t = size_t(i);
+    skipped += finite(t) ? 0 : 1;
+    set.boxes[t] = scene.triangle_box(t);
+    set.ids[t] = PrimitiveId{0, static_cast<uint32_t>(t)};
+  }
+  if (skipped) {
+    size_t kept = 0;
+    for (size_t t = 0; t < n; ++t)
+      if (finite(t)) set.boxes[kept] = set.boxes[t], set.ids[kept] = set.ids[t], ++kept;
+    set.boxes.resize(kept);
+    set.ids.resize(kept);
   }
   if (dropped) *dropped = skipped;
   return set;

@@ -9,6 +9,7 @@
 #include "adapters/builder_registry.h"
 #include "adapters/out/cpu_isa.h"
 #include "cuda/metrics/sah.h"
+#include "cuda/core/parallel_errors.h"
 #include "cuda/core/refit.h"
 #include "plugin/plugin_config.h"
 #include "plugin/real_embree.h"
@@ -163,14 +164,23 @@ bool SceneAccel::refit(CommitMeshes& input, std::vector<GeometryFilters> filters
   GroupedBvh& trees = base.trees;
   size_t rebuilt = 0;
   BuildInfo info;
+  // Every mesh's tree refitted and priced at once (each over its own part of the boxes),
+  // then the spoilt ones built again one after another (each build is parallel itself).
+  std::vector<double> refitted_sah(trees.groups());
+  ParallelErrors errors;
+#pragma omp parallel for schedule(dynamic, 1)
+  for (int64_t g = 0; g < int64_t(trees.groups()); ++g)
+    errors.capture([&] {
+      refit_in_place(trees.trees[size_t(g)], prims.boxes.data() + trees.first[size_t(g)]);
+      refitted_sah[size_t(g)] = sah_cost(trees.trees[size_t(g)]);
+    });
+  errors.rethrow();
   for (size_t g = 0; g < trees.groups(); ++g) {
-    refit_in_place(trees.trees[g], prims.boxes.data() + trees.first[g]);
     const uint32_t geom = flat.ids[trees.first[g]].geom;
     if (trees.groups() > 1 && geom < refit_meshes.size() && refit_meshes[geom]) continue;  // as asked
-    const double sah = sah_cost(trees.trees[g]);
-    if (sah <= kRefitSahLimit * trees.built_sah[g]) continue;
+    if (refitted_sah[g] <= kRefitSahLimit * trees.built_sah[g]) continue;
     if (trees.groups() == 1) {
-      why = fmt::format("a refit's SAH {:.2f} is above {} times the build's {:.2f}", sah, kRefitSahLimit,
+      why = fmt::format("a refit's SAH {:.2f} is above {} times the build's {:.2f}", refitted_sah[g], kRefitSahLimit,
                         trees.built_sah[g]);
       return false;
     }
