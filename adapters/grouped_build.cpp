@@ -1,9 +1,15 @@
 #include "grouped_build.h"
 
 #include <fmt/format.h>
+#include <omp.h>
 
+#include <algorithm>
+#include <atomic>
 #include <stdexcept>
+#include <thread>
 
+#include "cuda/core/parallel_errors.h"
+#include "cuda/core/threads.h"
 #include "cuda/metrics/sah.h"
 #include "cuda/sweep_sah/sweep_sah.h"
 
@@ -63,18 +69,73 @@ GroupedBvh build_grouped(const BuilderConfig& config, const PrimitiveSet& prims,
   grouped.first = first;
   grouped.trees.resize(first.size());
   grouped.built_sah.resize(first.size());
-  for (size_t g = 0; g < first.size(); ++g) rebuild_group(grouped, g, config, prims, info, context);
+  std::vector<size_t> all(first.size());
+  for (size_t g = 0; g < all.size(); ++g) all[g] = g;
+  rebuild_groups(grouped, all, config, prims, info, context);
   return grouped;
 }
 
-void rebuild_group(GroupedBvh& grouped, size_t g, const BuilderConfig& config, const PrimitiveSet& prims,
-                   BuildInfo* info, BuildContext* context) {
+namespace {
+
+void build_group(GroupedBvh& grouped, size_t g, const BuilderConfig& config, const PrimitiveSet& prims,
+                 BuildInfo* info, BuildContext* context) {
   BuildInfo group_info;
   BuildInfo* counted = info ? &group_info : nullptr;
   grouped.trees[g] = grouped.groups() == 1 ? run_builder(config, prims, counted, context)  // no copy of the set
                                            : run_builder(config, group_primitives(prims, grouped.first, g), counted, context);
   grouped.built_sah[g] = sah_cost(grouped.trees[g]);
   add_counters(info, group_info);
+}
+
+}  // namespace
+
+void rebuild_groups(GroupedBvh& grouped, const std::vector<size_t>& which, const BuilderConfig& config,
+                    const PrimitiveSet& prims, BuildInfo* info, BuildContext* context) {
+  const auto threads = size_t(std::max(1, thread_count()));
+  size_t total = 0;
+  for (const size_t g : which) total += grouped.group_size(g, prims.size());
+  std::vector<size_t> small;
+  for (const size_t g : which) {
+    if (threads == 1 || grouped.group_size(g, prims.size()) * threads > total)
+      build_group(grouped, g, config, prims, info, context);  // every thread on it
+    else
+      small.push_back(g);
+  }
+  if (small.empty()) return;
+  // The largest first, so that the last builds to start are short.
+  std::sort(small.begin(), small.end(), [&](size_t a, size_t b) {
+    return grouped.group_size(a, prims.size()) > grouped.group_size(b, prims.size());
+  });
+  const size_t workers = std::min(threads, small.size());
+  if (grouped.thread_contexts.size() < workers) grouped.thread_contexts.resize(workers);
+  std::vector<BuildInfo> infos(workers);
+  std::atomic<size_t> next{0};
+  ParallelErrors errors;
+  // std::threads, not an OpenMP region: each sets its own OpenMP thread count to one, so
+  // the builder's parallel regions (and whatever sizes work by omp_get_max_threads, as the
+  // radix sort does) run as they would in a one-thread process. Nested OpenMP regions would
+  // get one thread while omp_get_max_threads still said two.
+  const auto work = [&](size_t w) {
+    omp_set_num_threads(1);
+    for (size_t i; (i = next.fetch_add(1)) < small.size();)
+      errors.capture([&] {
+        build_group(grouped, small[i], config, prims, info ? &infos[w] : nullptr, &grouped.thread_contexts[w]);
+      });
+  };
+  std::vector<std::thread> pool;
+  try {
+    for (size_t w = 0; w < workers; ++w) pool.emplace_back(work, w);
+  } catch (...) {
+    // A thread that cannot start leaves the groups to those that did.
+  }
+  for (std::thread& t : pool) t.join();
+  if (pool.empty()) {  // none could: this thread builds every group, its thread count kept
+    const int before = omp_get_max_threads();
+    work(0);
+    omp_set_num_threads(before);
+  }
+  errors.rethrow();
+  for (const BuildInfo& i : infos) add_counters(info, i);
 }
 
 void join_groups(const GroupedBvh& grouped, Bvh& out) {

@@ -8,6 +8,7 @@
 
 #include "adapters/grouped_build.h"
 #include "cuda/core/refit.h"
+#include "cuda/core/threads.h"
 #include "cuda/metrics/sah.h"
 #include "cuda/metrics/validate.h"
 #include "support/builder_specs.h"
@@ -89,9 +90,36 @@ TEST(GroupedBuild, GroupsRefittedOrBuiltAgainOnTheirOwn) {
   const PrimitiveSet prims = make_primitive_set(after);
   for (size_t g = 0; g < 3; ++g) refit_in_place(grouped.trees[g], prims.boxes.data() + grouped.first[g]);
   EXPECT_NEAR(sah_cost(grouped.trees[2]), grouped.built_sah[2], 1e-9 * grouped.built_sah[2]);  // unchanged
-  rebuild_group(grouped, 0, config, prims);
+  rebuild_groups(grouped, {0}, config, prims);
   EXPECT_DOUBLE_EQ(grouped.built_sah[0], sah_cost(grouped.trees[0]));
   expect_joined_tree_right(grouped, prims, after, config, "after a refit and a rebuild");
+}
+
+// Small groups are built at once, a thread each (rebuild_groups): every tree is the one its
+// group's build gives alone, with one thread or two, and the contexts are kept for the next.
+TEST(GroupedBuild, GroupsBuiltAtOnceAreTheirOwnBuildsTrees) {
+  const TriangleScene scene = three_clusters(300.0f);
+  const PrimitiveSet prims = make_primitive_set(scene);
+  const std::vector<uint32_t> first = {0, 300, 700, 1000, 1700, 2000, 2400};  // seven groups, none half the set
+  for (const char* spec : {"Q1", "Q3S", "lbvh"}) {
+    const BuilderConfig config = test::config_from_spec(spec);
+    for (const int threads : {1, 2}) {
+      set_thread_count(threads);
+      const GroupedBvh grouped = build_grouped(config, prims, first);
+      set_thread_count(0);
+      EXPECT_EQ(grouped.thread_contexts.size(), threads == 1 ? 0u : 2u) << spec;
+      for (size_t g = 0; g < first.size(); ++g) {
+        const Bvh alone = run_builder(config, group_primitives(prims, first, g));
+        const Bvh& got = grouped.trees[g];
+        ASSERT_EQ(got.prim_indices, alone.prim_indices) << spec << ", " << threads << " threads, group " << g;
+        ASSERT_EQ(got.nodes.size(), alone.nodes.size()) << spec << ", group " << g;
+        for (size_t i = 0; i < got.nodes.size(); ++i) {
+          ASSERT_EQ(got.nodes[i].box, alone.nodes[i].box) << spec << ", group " << g << ", node " << i;
+          ASSERT_EQ(got.nodes[i].first, alone.nodes[i].first) << spec << ", group " << g << ", node " << i;
+        }
+      }
+    }
+  }
 }
 
 TEST(GroupedBuild, OneGroupIsTheBuildersTree) {

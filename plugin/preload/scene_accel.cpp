@@ -162,10 +162,9 @@ bool SceneAccel::refit(CommitMeshes& input, std::vector<GeometryFilters> filters
   // In place: what is traced is the layout, made below, and every refit recomputes every
   // box, so a refit refused here leaves nothing behind that matters.
   GroupedBvh& trees = base.trees;
-  size_t rebuilt = 0;
   BuildInfo info;
   // Every mesh's tree refitted and priced at once (each over its own part of the boxes),
-  // then the spoilt ones built again one after another (each build is parallel itself).
+  // then the spoilt ones built again (rebuild_groups).
   std::vector<double> refitted_sah(trees.groups());
   ParallelErrors errors;
 #pragma omp parallel for schedule(dynamic, 1)
@@ -175,6 +174,7 @@ bool SceneAccel::refit(CommitMeshes& input, std::vector<GeometryFilters> filters
       refitted_sah[size_t(g)] = sah_cost(trees.trees[size_t(g)]);
     });
   errors.rethrow();
+  std::vector<size_t> spoilt;
   for (size_t g = 0; g < trees.groups(); ++g) {
     const uint32_t geom = flat.ids[trees.first[g]].geom;
     if (trees.groups() > 1 && geom < refit_meshes.size() && refit_meshes[geom]) continue;  // as asked
@@ -184,9 +184,10 @@ bool SceneAccel::refit(CommitMeshes& input, std::vector<GeometryFilters> filters
                         trees.built_sah[g]);
       return false;
     }
-    rebuild_group(trees, g, base.config, prims, &info, context);
-    ++rebuilt;
+    spoilt.push_back(g);
   }
+  rebuild_groups(trees, spoilt, base.config, prims, &info, context);
+  const size_t rebuilt = spoilt.size();
   base.join();
   const Bvh& traced = base.traced();
   report.builder = "refit of " + base.config.label();
