@@ -49,6 +49,55 @@ TEST(EmbreeGeometry, HonoursOffsetStrideAndDropsWhatEmbreeDrops) {
   EXPECT_EQ(f.scene.positions[last[1]].x, 1.0f);
 }
 
+// A commit flattened over the last one's arrays (a dynamic scene's): the result is the
+// fresh flattening's, in the earlier memory, and says whether every triangle and id is as
+// it was: moved vertices keep them, a changed index, a dropped triangle (a vertex gone
+// non-finite) or another count do not.
+TEST(EmbreeGeometry, FlattenedOverAnEarlierCommitSaysWhetherItsTrianglesAreTheSame) {
+  float v[] = {0, 0, 0, 1, 0, 0, 0, 1, 0, 1, 1, 0};
+  uint32_t t[] = {0, 1, 2, 1, 3, 2};
+  const EmbreeTriangleMesh m{4, {v, RTC_FORMAT_FLOAT3, 12, 4}, {t, RTC_FORMAT_UINT3, 12, 2}};
+  const auto expect_fresh = [&](const FlattenedMeshes& got, const std::vector<EmbreeTriangleMesh>& meshes) {
+    const FlattenedMeshes fresh = flatten_triangle_meshes(meshes);
+    EXPECT_EQ(got.scene.positions, fresh.scene.positions);
+    EXPECT_EQ(got.scene.triangles, fresh.scene.triangles);
+    ASSERT_EQ(got.ids.size(), fresh.ids.size());
+    for (size_t i = 0; i < got.ids.size(); ++i)
+      EXPECT_TRUE(got.ids[i].geom == fresh.ids[i].geom && got.ids[i].prim == fresh.ids[i].prim);
+  };
+  FlattenedMeshes earlier = flatten_triangle_meshes({m});
+  const Triangle* memory = earlier.scene.triangles.data();
+  bool same = false;
+  v[0] = 0.5f;  // a vertex moved
+  FlattenedMeshes moved = flatten_triangle_meshes({m}, &earlier, &same);
+  EXPECT_TRUE(same);
+  EXPECT_EQ(moved.scene.triangles.data(), memory);
+  EXPECT_TRUE(earlier.scene.triangles.empty() && earlier.ids.empty());
+  expect_fresh(moved, {m});
+  t[4] = 0;  // an index changed
+  FlattenedMeshes reindexed = flatten_triangle_meshes({m}, &moved, &same);
+  EXPECT_FALSE(same);
+  expect_fresh(reindexed, {m});
+  t[4] = 3;
+  FlattenedMeshes back = flatten_triangle_meshes({m}, &reindexed, &same);
+  EXPECT_FALSE(same);  // compared with the reindexed one
+  v[9] = std::numeric_limits<float>::infinity();  // triangle 1 dropped
+  FlattenedMeshes dropped = flatten_triangle_meshes({m}, &back, &same);
+  EXPECT_FALSE(same);
+  expect_fresh(dropped, {m});
+  v[9] = 1.0f;
+  EmbreeTriangleMesh other_id = m;
+  other_id.geom_id = 5;  // the same triangles under another geometry id
+  FlattenedMeshes renamed = flatten_triangle_meshes({other_id}, &dropped, &same);
+  EXPECT_FALSE(same);
+  FlattenedMeshes again = flatten_triangle_meshes({other_id}, &renamed, &same);
+  EXPECT_TRUE(same);
+  expect_fresh(again, {other_id});
+  FlattenedMeshes none = flatten_triangle_meshes({}, &again, &same);
+  EXPECT_FALSE(same);
+  EXPECT_TRUE(none.scene.triangles.empty() && none.ids.empty());
+}
+
 TEST(EmbreeGeometry, RefusesFormatsItCannotRead) {
   const float v[9] = {0, 0, 0, 1, 0, 0, 0, 1, 0};
   const uint32_t t[3] = {0, 1, 2};

@@ -2,6 +2,7 @@
 
 #include <fmt/format.h>
 
+#include <algorithm>
 #include <cmath>
 #include <cstring>
 
@@ -40,8 +41,32 @@ T read_at(const EmbreeBufferView& view, size_t i) {
 
 }  // namespace
 
-FlattenedMeshes flatten_triangle_meshes(const std::vector<EmbreeTriangleMesh>& meshes) {
+FlattenedMeshes flatten_triangle_meshes(const std::vector<EmbreeTriangleMesh>& meshes, FlattenedMeshes* reuse,
+                                        bool* same_as_reused) {
   FlattenedMeshes out;
+  size_t earlier = 0;  // triangles (and ids) of the reused flattening, compared as they are overwritten
+  if (reuse) {
+    out.scene.positions = std::move(reuse->scene.positions);
+    out.scene.positions.clear();
+    out.scene.triangles = std::move(reuse->scene.triangles);
+    out.ids = std::move(reuse->ids);
+    earlier = std::min(out.scene.triangles.size(), out.ids.size());
+    *reuse = FlattenedMeshes();
+  }
+  bool same = reuse != nullptr;
+  size_t kept = 0;
+  const auto put = [&](const Triangle& triangle, PrimitiveId id) {
+    if (kept < earlier) {
+      const PrimitiveId was = out.ids[kept];
+      same = same && out.scene.triangles[kept] == triangle && was.geom == id.geom && was.prim == id.prim;
+      out.scene.triangles[kept] = triangle;
+      out.ids[kept] = id;
+    } else {
+      out.scene.triangles.push_back(triangle);
+      out.ids.push_back(id);
+    }
+    ++kept;
+  };
   out.scene.name = "embree scene";
   size_t total = 0, vertices = 0;
   for (const EmbreeTriangleMesh& m : meshes) {
@@ -76,10 +101,13 @@ FlattenedMeshes flatten_triangle_meshes(const std::vector<EmbreeTriangleMesh>& m
         ++out.dropped;
         continue;
       }
-      out.scene.triangles.push_back({base + tri[0], base + tri[1], base + tri[2]});
-      out.ids.push_back(PrimitiveId{m.geom_id, uint32_t(t)});
+      put({base + tri[0], base + tri[1], base + tri[2]}, PrimitiveId{m.geom_id, uint32_t(t)});
     }
   }
+  if (kept != earlier) same = false;
+  out.scene.triangles.resize(kept);
+  out.ids.resize(kept);
+  if (same_as_reused) *same_as_reused = same;
   return out;
 }
 

@@ -45,7 +45,11 @@ class UnsupportedMesh : public std::runtime_error {
 
 // Triangles with an index out of range, or a vertex that is not finite or lies beyond
 // Embree's range (|x| >= 1.8e18), are dropped, as rtcCommitScene drops them. Throws
-// UnsupportedMesh for a mesh kmbvh cannot read.
-FlattenedMeshes flatten_triangle_meshes(const std::vector<EmbreeTriangleMesh>& meshes);
+// UnsupportedMesh for a mesh kmbvh cannot read. `reuse`: an earlier flattening (the same
+// scene's last commit), whose memory this one takes, so that a scene committed again
+// writes no fresh pages; `same_as_reused`, where given, then says whether every triangle
+// and id came out as they were in it (only vertices moved: a refit may do).
+FlattenedMeshes flatten_triangle_meshes(const std::vector<EmbreeTriangleMesh>& meshes,
+                                        FlattenedMeshes* reuse = nullptr, bool* same_as_reused = nullptr);
 
 }  // namespace kmbvh

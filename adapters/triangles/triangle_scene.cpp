@@ -42,7 +42,7 @@ void TriangleScene::add_triangle(Vec3 a, Vec3 b, Vec3 c) {
   if (!triangle_material.empty()) triangle_material.push_back(0);
 }
 
-PrimitiveSet make_primitive_set(const TriangleScene& scene, size_t* dropped) {
+PrimitiveSet make_primitive_set(const TriangleScene& scene, size_t* dropped, PrimitiveSet* reuse) {
   // Every triangle's box in one parallel pass (a scene commit makes the set for each build
   // and refit: 1.14M triangles took 12 ms on one thread); the rare scene with non-finite
   // vertices then has those triangles taken out, the others kept in order.
@@ -52,6 +52,11 @@ PrimitiveSet make_primitive_set(const TriangleScene& scene, size_t* dropped) {
     return is_finite(scene.positions[v[0]]) && is_finite(scene.positions[v[1]]) && is_finite(scene.positions[v[2]]);
   };
   PrimitiveSet set;
+  if (reuse) {
+    set = std::move(*reuse);
+    set.clear();
+    *reuse = PrimitiveSet();
+  }
   grow_on_huge_pages(set.boxes, n);
   grow_on_huge_pages(set.ids, n);
   size_t skipped = 0;

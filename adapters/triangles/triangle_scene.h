@@ -49,7 +49,8 @@ class SceneError : public std::runtime_error {
 
 // One box per triangle; ids are the triangles' indices. Triangles with a non-finite
 // vertex are left out, as Embree's scene commit leaves them out; `dropped` counts them.
-PrimitiveSet make_primitive_set(const TriangleScene& scene, size_t* dropped = nullptr);
+// `reuse`: an earlier set whose memory this one takes (a scene committed again).
+PrimitiveSet make_primitive_set(const TriangleScene& scene, size_t* dropped = nullptr, PrimitiveSet* reuse = nullptr);
 
 // The bounds of the middle 98% of the boxes' centres on each axis (a flat core padded to 1%
 // of its widest side): where the scene is, without the far outliers that its bounds include.

@@ -88,10 +88,11 @@ void SceneAccel::set_filters(std::vector<GeometryFilters> filters) {
   }
 }
 
-CommitMeshes::CommitMeshes(const std::vector<EmbreeTriangleMesh>& meshes_in) : meshes(meshes_in.size()) {
+CommitMeshes::CommitMeshes(const std::vector<EmbreeTriangleMesh>& meshes_in, CommitMeshes* reuse)
+    : meshes(meshes_in.size()) {
   const auto start = std::chrono::steady_clock::now();
-  flat = flatten_triangle_meshes(meshes_in);
-  if (!flat.scene.triangles.empty()) prims = make_primitive_set(flat.scene);
+  flat = flatten_triangle_meshes(meshes_in, reuse ? &reuse->flat : nullptr, reuse ? &same_triangles : nullptr);
+  if (!flat.scene.triangles.empty()) prims = make_primitive_set(flat.scene, nullptr, reuse ? &reuse->prims : nullptr);
   ms = std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count();
 }
 
@@ -119,8 +120,6 @@ SceneAccel::SceneAccel(CommitMeshes input, std::vector<GeometryFilters> filters,
       if (meshes.size() > 1) report.builder += fmt::format(", a tree per mesh ({})", meshes.size());
       base.trees = build_grouped(config, prims, meshes, &info, context);
       base.join();
-      base.triangles = flat.scene.triangles;
-      base.ids = flat.ids;
       base.config = config;
     } else {
       bvh = run_builder(config, prims, &info, context);
@@ -133,7 +132,9 @@ SceneAccel::SceneAccel(CommitMeshes input, std::vector<GeometryFilters> filters,
                                        previous ? previous->tracer_.get() : nullptr);
     report.layout_ms = tracer_->layout_ms();
   }
-  if (plugin_config().ab.on) geometry_ = std::make_unique<AccelGeometry>(std::move(flat));
+  if (plugin_config().ab.on)
+    geometry_ = std::make_unique<AccelGeometry>(refit_base_ ? FlattenedMeshes(flat) : std::move(flat));
+  if (refit_base_) refit_base_->meshes = std::make_unique<CommitMeshes>(std::move(input));
 }
 
 bool SceneAccel::refit(CommitMeshes& input, std::vector<GeometryFilters> filters, const std::vector<bool>& refit_meshes,
@@ -146,19 +147,14 @@ bool SceneAccel::refit(CommitMeshes& input, std::vector<GeometryFilters> filters
   const auto start = Clock::now();
   const FlattenedMeshes& flat = input.flat;
   RefitBase& base = *refit_base_;
-  // The same triangles: the same vertex indices, and the same ones kept (a vertex that
-  // became non-finite drops its triangles, as Embree's commit does).
-  const auto same_id = [](PrimitiveId a, PrimitiveId b) { return a.geom == b.geom && a.prim == b.prim; };
-  if (flat.scene.triangles != base.triangles ||
-      !std::equal(flat.ids.begin(), flat.ids.end(), base.ids.begin(), base.ids.end(), same_id)) {
-    why = "its triangles changed";
+  // The same triangles as the trees': the same vertex indices, and the same ones kept (a
+  // vertex that became non-finite drops its triangles, as Embree's commit does), found as the
+  // commit's meshes were flattened over the kept ones (CommitMeshes' reuse).
+  if (!input.same_triangles) {
+    why = "its triangles changed (or the tree's were not kept)";
     return false;
   }
   const PrimitiveSet& prims = input.prims;
-  if (prims.size() != base.triangles.size()) {  // flattening keeps finite triangles only: never, but cheap
-    why = "its primitives changed";
-    return false;
-  }
   // In place: what is traced is the layout, made below, and every refit recomputes every
   // box, so a refit refused here leaves nothing behind that matters.
   GroupedBvh& trees = base.trees;
@@ -204,9 +200,12 @@ bool SceneAccel::refit(CommitMeshes& input, std::vector<GeometryFilters> filters
                                          tracer_.get());
   report.layout_ms = tracer->layout_ms();
   std::unique_ptr<AccelGeometry> geometry =
-      geometry_ ? std::make_unique<AccelGeometry>(std::move(input.flat)) : nullptr;
+      geometry_ ? std::make_unique<AccelGeometry>(FlattenedMeshes(input.flat)) : nullptr;
+  auto kept = std::make_unique<CommitMeshes>();
   // Nothing throws past here. (The new layout has the old one's memory already: a throw
   // above leaves this tree answering misses until the caller builds the scene again.)
+  *kept = std::move(input);
+  base.meshes = std::move(kept);
   tracer_ = std::move(tracer);
   geometry_ = std::move(geometry);
   set_filters(std::move(filters));

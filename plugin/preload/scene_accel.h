@@ -61,12 +61,17 @@ struct AccelGeometry {
 // once: a dynamic scene's commit tries a refit with them and, where the refit is refused,
 // builds from them, instead of reading the meshes again. Throws as flatten_triangle_meshes
 // does (UnsupportedMesh): the caller lets Embree answer for the scene.
+// `reuse`: the meshes of the scene's last build or refit, whose memory these take (a dynamic
+// scene's commits then write no fresh pages for them); same_triangles then says whether every
+// triangle and id is as it was there.
 struct CommitMeshes {
   FlattenedMeshes flat;
   PrimitiveSet prims;
   size_t meshes = 0;
   double ms = 0;  // what making them took, counted in the build's or the refit's time
-  explicit CommitMeshes(const std::vector<EmbreeTriangleMesh>& meshes);
+  bool same_triangles = false;
+  CommitMeshes() = default;
+  explicit CommitMeshes(const std::vector<EmbreeTriangleMesh>& meshes, CommitMeshes* reuse = nullptr);
 };
 
 class SceneAccel {
@@ -103,6 +108,11 @@ class SceneAccel {
   // since each mesh's build has a cost of its own.
   static constexpr size_t kMaxMeshTrees = 256;
 
+  // A dynamic scene's meshes as its trees were last built or refitted over, handed to the
+  // next commit's CommitMeshes to reuse and compare with (null where none are kept: a static
+  // scene, or taken already). refit() and a new SceneAccel keep that commit's in turn.
+  std::unique_ptr<CommitMeshes> take_meshes() { return refit_base_ ? std::move(refit_base_->meshes) : nullptr; }
+
   // Whether some geometry has a filter for this query (most scenes: none, and the
   // traversal runs without offering hits).
   bool has_filters(Query query) const { return query == Query::Any ? occluded_filters_ : intersect_filters_; }
@@ -135,13 +145,12 @@ class SceneAccel {
   void set_filters(std::vector<GeometryFilters> filters);
 
   // What a refit starts from: the trees as built (a tree per mesh, or one), the tree the
-  // layout took (their join, kept for its memory), the triangles and ids they were built
-  // over, and the builder that built them.
+  // layout took (their join, kept for its memory), the meshes they were built or last
+  // refitted over (take_meshes), and the builder that built them.
   struct RefitBase {
     GroupedBvh trees;
     Bvh joined;
-    std::vector<Triangle> triangles;
-    std::vector<PrimitiveId> ids;
+    std::unique_ptr<CommitMeshes> meshes;
     BuilderConfig config;
     const Bvh& traced() const { return trees.groups() == 1 ? trees.trees[0] : joined; }
     void join() {

@@ -486,9 +486,12 @@ void commit_or_build(RTCScene scene, bool join) {
   }
 
   // The meshes read once, for a refit and, where it is refused, the build (CommitMeshes).
+  // A dynamic scene's meshes are flattened over those its trees were made from (reused
+  // memory, and the comparison that tells whether a refit may do).
   std::unique_ptr<CommitMeshes> input;
   try {
-    input = std::make_unique<CommitMeshes>(meshes);
+    std::unique_ptr<CommitMeshes> kept = refittable && s->owned ? s->owned->take_meshes() : nullptr;
+    input = std::make_unique<CommitMeshes>(meshes, kept.get());
   } catch (const std::exception& e) {
     return commit_by_embree(scene, *s, join, std::string("kmbvh could not build it: ") + e.what(), instanced);
   }
