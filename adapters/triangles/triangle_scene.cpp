@@ -43,9 +43,9 @@ void TriangleScene::add_triangle(Vec3 a, Vec3 b, Vec3 c) {
 }
 
 PrimitiveSet make_primitive_set(const TriangleScene& scene, size_t* dropped, PrimitiveSet* reuse) {
-  // Every triangle's box in one parallel pass (a scene commit makes the set for each build
-  // and refit: 1.14M triangles took 12 ms on one thread); the rare scene with non-finite
-  // vertices then has those triangles taken out, the others kept in order.
+  // Every triangle's box in one parallel pass (the scene path makes the set at every commit,
+  // for the build or the refit); the rare scene with non-finite vertices then has those
+  // triangles taken out, the others kept in order.
   const size_t n = scene.size();
   const auto finite = [&](size_t t) {
     const Triangle& v = scene.triangles[t];

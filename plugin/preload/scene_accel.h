@@ -96,9 +96,10 @@ class SceneAccel {
   // the motion did); then only the top tree over the meshes is built anew. `context`: the
   // scene's build memory, for those builds. Returns false, changing nothing that is traced,
   // where it cannot: no tree kept, triangles added, dropped or re-indexed, or a single
-  // tree whose refit is spoilt (a rebuild of the scene pays). Not during traces (Embree's rule for a commit). Throws as the constructor does;
-  // the new layout is made in the old one's memory, so after a throw this tree answers every
-  // ray with a miss until the caller builds the scene again.
+  // tree whose refit is spoilt (a rebuild of the scene pays). Not during traces (Embree's
+  // rule for a commit). Throws as the constructor does; the new layout is made in the old
+  // one's memory, so after a throw this tree answers every ray with a miss until the caller
+  // builds the scene again.
   // `why`: the reason, where it returns false; `input` is then as it was, for a build.
   bool refit(CommitMeshes& input, std::vector<GeometryFilters> filters, const std::vector<bool>& refit_meshes,
              AccelReport& report, std::string& why, BuildContext* context = nullptr);
