@@ -3,6 +3,7 @@
 // picks the cheapest split at every node (exhaustive check); LBVH's radix tree matches an
 // independent reference; the CPU radix sort matches std::stable_sort.
 #include <gtest/gtest.h>
+#include <omp.h>
 
 #include <algorithm>
 #include <functional>
@@ -293,6 +294,30 @@ TEST(RadixSort, MatchesStableSort) {
       }
     }
   }
+}
+
+// Called from inside another OpenMP region, where its own region gets one thread (nesting
+// off) while omp_get_max_threads says two: the whole array is still sorted.
+TEST(RadixSort, SortsWholeInsideAnotherParallelRegion) {
+  const size_t n = 200000;
+  std::mt19937_64 rng(7);
+  std::vector<uint64_t> keys(n), key_scratch(n);
+  std::vector<uint32_t> values(n), value_scratch(n);
+  for (size_t i = 0; i < n; ++i) keys[i] = rng() >> 4, values[i] = uint32_t(i);
+  set_thread_count(2);
+  int max_threads_inside = 0;
+#pragma omp parallel num_threads(2)
+#pragma omp single
+  {
+    max_threads_inside = omp_get_max_threads();
+    radix_sort_pairs(keys.data(), values.data(), n, 60, key_scratch.data(), value_scratch.data());
+  }
+  set_thread_count(0);
+  EXPECT_EQ(max_threads_inside, 2);  // the case: the sort is told of two threads and gets one
+  EXPECT_TRUE(std::is_sorted(keys.begin(), keys.end()));
+  std::vector<uint32_t> seen(values);
+  std::sort(seen.begin(), seen.end());
+  for (size_t i = 0; i < n; ++i) ASSERT_EQ(seen[i], uint32_t(i));
 }
 
 }  // namespace

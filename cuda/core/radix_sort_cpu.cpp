@@ -28,10 +28,12 @@ void radix_sort_pairs(uint64_t* keys, uint32_t* values, size_t n, int key_bits, 
 
   for (int shift = 0; shift < key_bits; shift += kDigitBits) {
     bool skip = false;
+    // The parts are those of the threads the region really has: inside another OpenMP
+    // region (nesting off) it has one, however many omp_get_max_threads promised.
 #pragma omp parallel num_threads(threads)
     {
-      const int t = omp_get_thread_num();
-      const size_t begin = n * t / threads, end = n * (t + 1) / threads;
+      const int t = omp_get_thread_num(), parts = omp_get_num_threads();
+      const size_t begin = n * t / parts, end = n * (t + 1) / parts;
       size_t* h = histogram.data() + size_t(t) * kBuckets;
       std::fill(h, h + kBuckets, size_t(0));
       for (size_t i = begin; i < end; ++i) ++h[(src_k[i] >> shift) & (kBuckets - 1)];
@@ -42,7 +44,7 @@ void radix_sort_pairs(uint64_t* keys, uint32_t* values, size_t n, int key_bits, 
         size_t at = 0;
         for (size_t b = 0; b < kBuckets; ++b) {
           size_t bucket_total = 0;
-          for (int u = 0; u < threads; ++u) {
+          for (int u = 0; u < parts; ++u) {
             size_t& c = histogram[size_t(u) * kBuckets + b];
             const size_t count = c;
             c = at;
