@@ -112,9 +112,9 @@ void rebuild_groups(GroupedBvh& grouped, const std::vector<size_t>& which, const
   std::atomic<size_t> next{0};
   ParallelErrors errors;
   // std::threads, not an OpenMP region: each sets its own OpenMP thread count to one, so
-  // the builder's parallel regions (and whatever sizes work by omp_get_max_threads, as the
-  // radix sort does) run as they would in a one-thread process. Nested OpenMP regions would
-  // get one thread while omp_get_max_threads still said two.
+  // the builder's parallel regions, and whatever sizes its work by omp_get_max_threads, run
+  // as they would in a one-thread process. Nested OpenMP regions would get one thread while
+  // omp_get_max_threads still said two (the radix sort split its work so until 2026-12-07).
   const auto work = [&](size_t w) {
     omp_set_num_threads(1);
     for (size_t i; (i = next.fetch_add(1)) < small.size();)
