@@ -78,7 +78,7 @@ void* build(BvhObject& object, const RTCBuildArguments& a) {
   }();
 
   const PluginConfig& config = plugin_config();
-  BuilderConfig builder = builder_for(config, a.buildQuality);
+  BuilderConfig builder = builder_for(config, a.buildQuality, BuildPath::BuilderApi);
   builder.max_leaf_size = std::min(std::max(a.maxLeafSize, 1u), kBuilderLeafSize);
   builder.kmeans.wide = false;  // binary, widened to maxBranchingFactor by the SAH (embree_callbacks.h)
   builder.binary.sah = SahCosts{a.traversalCost, a.intersectionCost};

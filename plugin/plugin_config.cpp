@@ -68,6 +68,7 @@ PluginConfig read_plugin_config() {
     const BuilderConfig parsed = parse_builder(builder);  // throws for an unknown name
     c.builder = parsed.builder;
     if (parsed.builder == BuilderKind::Kmeans && builder != "kmeans") c.preset = parsed.preset;  // "Q4", "kmeans:Q4"
+    c.kmeans_asked = parsed.builder == BuilderKind::Kmeans;
   }
   if (!env("KMBVH_PRESET").empty()) {
     if (!kmeans_preset(env("KMBVH_PRESET")))
@@ -78,6 +79,7 @@ PluginConfig read_plugin_config() {
   c.p = env_count("KMBVH_P", 1, 1024);
   const std::string i = env("KMBVH_I");
   if (!i.empty()) c.i = env_count("KMBVH_I", 0, 1000) + 1;  // stored +1: 0 iterations is valid
+  c.kmeans_asked = c.kmeans_asked || !c.preset.empty() || c.k || c.p || c.i;
   const std::string backend = env("KMBVH_BACKEND");
   if (backend == "cuda")
     c.backend = Backend::Cuda;
@@ -109,18 +111,23 @@ const PluginConfig& plugin_config() {
   return config;
 }
 
-BuilderConfig builder_for(const PluginConfig& config, RTCBuildQuality quality) {
-  if (config.builder != BuilderKind::Kmeans) {
+BuilderConfig builder_for(const PluginConfig& config, RTCBuildQuality quality, BuildPath path) {
+  // Chosen by measurement (scripts/quality_table.py, the tables in plugin/README.md): LOW and
+  // MEDIUM take the kmbvh configuration nearest to dominating Embree's build of that quality
+  // on the shared scenes (LOW: LBVH, faster and cheaper than every k-means preset there);
+  // HIGH, where Embree's rtcBuildBVH builds MEDIUM's tree in MEDIUM's time, the k-means
+  // configuration with the lowest SAH cost, the faster of equals. A scene's LOW stays Q1:
+  // LBVH's leaves, chosen by the SAH, hold about two triangles, and the scene layout's blocks
+  // of four then stand half empty (Embree's dynamic_scene: 35% more memory, the layout 50%
+  // slower, the program no faster; plugin/README.md).
+  const bool lbvh_for_low = quality == RTC_BUILD_QUALITY_LOW && !config.kmeans_asked && path == BuildPath::BuilderApi;
+  if (config.builder != BuilderKind::Kmeans || lbvh_for_low) {
     BuilderConfig b;
-    b.builder = config.builder;
+    b.builder = lbvh_for_low ? BuilderKind::Lbvh : config.builder;
     b.backend = config.backend;
     return b;
   }
   std::string preset = config.preset;
-  // Chosen by measurement (scripts/quality_table.py, the table in plugin/README.md): LOW and
-  // MEDIUM take the k-means configuration nearest to dominating Embree's build of that
-  // quality on the shared scenes; HIGH, where Embree's rtcBuildBVH builds MEDIUM's tree in
-  // MEDIUM's time, the one with the lowest SAH cost, the faster of equals.
   if (preset.empty()) preset = quality == RTC_BUILD_QUALITY_LOW ? "Q1" : quality == RTC_BUILD_QUALITY_HIGH ? "Q2GR" : "Q1GS";
   BuilderConfig b = parse_builder("kmeans:" + preset);
   if (config.k || config.p || config.i) b.preset.clear();

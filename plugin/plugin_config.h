@@ -1,6 +1,7 @@
 // What the plug-in builds with, from the environment (read once per process):
-//   KMBVH_BUILDER  kmeans (default), any kmbvh builder (sweep-sah, lbvh, hlbvh, atrbvh,
-//                  ploc, Q1..Q5), or embree: every call passed to the real Embree
+//   KMBVH_BUILDER  kmeans, any kmbvh builder (sweep-sah, lbvh, hlbvh, atrbvh, ploc,
+//                  Q1..Q5), or embree: every call passed to the real Embree; default: by the
+//                  build quality (builder_for: LBVH for the builder API's LOW, else k-means)
 //   KMBVH_PRESET   k-means preset Q1..Q5, QA, or one followed by S; default: chosen by the build quality
 //   KMBVH_K, KMBVH_P, KMBVH_I   k-means parameters, overriding the preset's
 //   KMBVH_LOG=1    one line per build (and per scene) on stderr
@@ -39,6 +40,9 @@ struct PluginConfig {
   bool pass_through = false;  // KMBVH_BUILDER=embree
   BuilderKind builder = BuilderKind::Kmeans;
   std::string preset;         // empty: by build quality
+  // KMBVH_BUILDER=kmeans (or a preset), KMBVH_PRESET or KMBVH_K/P/I: k-means at every build
+  // quality, LOW included (otherwise LOW builds with LBVH: builder_for).
+  bool kmeans_asked = false;
   uint32_t k = 0, p = 0, i = 0;  // 0: the preset's
   Backend backend = Backend::Cpu;
   bool log = false;
@@ -55,9 +59,15 @@ PluginConfig read_plugin_config();
 // defaults are used.
 const PluginConfig& plugin_config();
 
-// The builder for one build of the given quality (LOW: Q1, MEDIUM: Q1GS, HIGH: Q2GR for
-// k-means, unless KMBVH_PRESET/K/P/I say otherwise; plugin/README.md has the table).
-BuilderConfig builder_for(const PluginConfig& config, RTCBuildQuality quality);
+// Who builds: an application's rtcBuildBVH, or a scene's commit (whose layout packs the
+// leaves' triangles four at a time).
+enum class BuildPath { BuilderApi, Scene };
+
+// The builder for one build of the given quality: LOW LBVH through the builder API and
+// k-means Q1 for a scene, MEDIUM k-means Q1GS, HIGH Q2GR, unless the environment names a
+// builder or k-means settings (then LOW's k-means preset is Q1); plugin/README.md has the
+// tables that chose them.
+BuilderConfig builder_for(const PluginConfig& config, RTCBuildQuality quality, BuildPath path);
 
 // KMBVH_LOG lines go through here (stderr, one write per line).
 void log_line(const std::string& line);

@@ -4,7 +4,7 @@
 // rtcNewBVH ... rtcReleaseBVH calls into kmbvh's; with KMBVH_SWAP=0
 // (kmbvh_example_custom_bvh_embree) it is Embree's program, unchanged.
 //
-//   kmbvh_example_custom_bvh [primitives]
+//   kmbvh_example_custom_bvh [primitives] [low|medium|high: the build quality, medium by default]
 #include <embree3/rtcore.h>
 #if KMBVH_SWAP
 #include "kmbvh/embree_swap.h"  // the one line
@@ -14,6 +14,7 @@
 #include <cstdio>
 #include <cstdlib>
 #include <random>
+#include <string>
 #include <vector>
 
 namespace {
@@ -69,6 +70,11 @@ void report_error(void*, RTCError code, const char* message) { std::fprintf(stde
 
 int main(int argc, char** argv) {
   const size_t n = argc > 1 ? std::strtoull(argv[1], nullptr, 10) : 1000000;
+  const std::string quality = argc > 2 ? argv[2] : "medium";  // low, medium or high
+  if (quality != "low" && quality != "medium" && quality != "high") {
+    std::fprintf(stderr, "usage: %s [primitives] [low|medium|high]\n", argv[0]);
+    return 2;
+  }
   RTCDevice device = rtcNewDevice(nullptr);
   rtcSetDeviceErrorFunction(device, report_error, nullptr);
 
@@ -84,7 +90,9 @@ int main(int argc, char** argv) {
   RTCBVH bvh = rtcNewBVH(device);
   RTCBuildArguments args = rtcDefaultBuildArguments();
   args.byteSize = sizeof(args);
-  args.buildQuality = RTC_BUILD_QUALITY_MEDIUM;
+  args.buildQuality = quality == "low"    ? RTC_BUILD_QUALITY_LOW
+                      : quality == "high" ? RTC_BUILD_QUALITY_HIGH
+                                          : RTC_BUILD_QUALITY_MEDIUM;
   args.maxBranchingFactor = 4;
   args.maxDepth = 1024;
   args.minLeafSize = 1;

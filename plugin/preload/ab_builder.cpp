@@ -97,8 +97,8 @@ void* ab_build_bvh(const RTCBuildArguments* args) {
     if (k.root) e = build_embree(theirs, copy.data(), false, twin);
   }
   try {
-    ab_note_build(BuildComparison{args->primitiveCount, args->buildQuality,
-                                  builder_for(plugin_config(), args->buildQuality).label(), embree_answers, side_of(k),
+    const std::string builder = builder_for(plugin_config(), args->buildQuality, BuildPath::BuilderApi).label();
+    ab_note_build(BuildComparison{args->primitiveCount, args->buildQuality, builder, embree_answers, side_of(k),
                                   side_of(e)});
   } catch (...) {  // out of memory for the report: this build goes unreported
   }

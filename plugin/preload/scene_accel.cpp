@@ -102,7 +102,7 @@ SceneAccel::SceneAccel(CommitMeshes input, std::vector<GeometryFilters> filters,
   using Clock = std::chrono::steady_clock;
   const auto start = Clock::now();
   FlattenedMeshes& flat = input.flat;
-  const BuilderConfig config = builder_for(plugin_config(), quality);
+  const BuilderConfig config = builder_for(plugin_config(), quality, BuildPath::Scene);
   report.builder = config.label();
   report.meshes = input.meshes;
   report.dropped = flat.dropped;

@@ -8,6 +8,15 @@ app=$1 lib=$2
 out=$(KMBVH_LOG=1 LD_PRELOAD="$lib" "$app" 200000 2>&1)
 echo "$out"
 grep -q "kmbvh: rtcBuildBVH: kmeans Q1GS, 200000 primitives" <<<"$out"
+# LOW builds with LBVH (plugin/README.md, "Build quality"), unless k-means is asked for.
+out=$(KMBVH_LOG=1 LD_PRELOAD="$lib" "$app" 200000 low 2>&1)
+grep -q "kmbvh: rtcBuildBVH: lbvh, 200000 primitives" <<<"$out" || { echo "$out"; echo "LOW did not build with lbvh"; exit 1; }
+for asked in KMBVH_BUILDER=kmeans KMBVH_PRESET=Q1 KMBVH_K=8; do
+  out=$(env KMBVH_LOG=1 "$asked" LD_PRELOAD="$lib" "$app" 200000 low 2>&1)
+  grep -q "kmbvh: rtcBuildBVH: kmeans .*, 200000 primitives" <<<"$out" || { echo "$out"; echo "$asked: LOW did not build with k-means"; exit 1; }
+done
+out=$(KMBVH_LOG=1 LD_PRELOAD="$lib" "$app" 200000 high 2>&1)
+grep -q "kmbvh: rtcBuildBVH: kmeans Q2GR, 200000 primitives" <<<"$out" || { echo "$out"; echo "HIGH did not build with Q2GR"; exit 1; }
 out=$(KMBVH_LOG=1 KMBVH_BUILDER=ploc LD_PRELOAD="$lib" "$app" 200000 2>&1)
 grep -q "kmbvh: rtcBuildBVH: ploc, 200000 primitives" <<<"$out"
 out=$(KMBVH_LOG=1 KMBVH_BUILDER=embree LD_PRELOAD="$lib" "$app" 200000 2>&1)
@@ -16,4 +25,4 @@ grep -q "200000 leaves" <<<"$out"
 out=$(KMBVH_LOG=1 KMBVH_BUILDER=nonsense LD_PRELOAD="$lib" "$app" 200000 2>&1)
 grep -q "unknown builder 'nonsense'" <<<"$out"
 grep -q "kmbvh: rtcBuildBVH: kmeans Q1GS" <<<"$out"
-echo "preload builder API: kmbvh by default, Embree on request, bad settings reported"
+echo "preload builder API: kmbvh by default (by build quality), Embree on request, bad settings reported"

@@ -24,6 +24,8 @@
 //           the refitted trees are far worse than new ones and kmbvh builds them again.
 // --refit-quality: every mesh asks for refits (RTC_BUILD_QUALITY_REFIT), which Embree and
 //           kmbvh then refit however the motion spoils them.
+// --low:    the scene asks for RTC_BUILD_QUALITY_LOW, as Embree's dynamic_scene tutorial does
+//           (kmbvh then builds with k-means Q1: plugin/README.md, "Build quality").
 #include <embree3/rtcore.h>
 #include <fmt/format.h>
 
@@ -65,7 +67,8 @@ constexpr int kFormCount = 8;
 
 struct Options {
   std::string scene;
-  bool filter = false, quad = false, exact_forms = false, dynamic = false, scatter = false, refit_quality = false;
+  bool filter = false, quad = false, exact_forms = false, dynamic = false, scatter = false, refit_quality = false,
+       low = false;
 };
 
 // Where --dynamic moves a vertex: the scene grown by 1%, shifted along x and rippled in y,
@@ -123,6 +126,7 @@ std::vector<Ray> all_rays(const TriangleScene& scene, std::vector<unsigned>& mas
 RTCScene build_scene(RTCDevice device, const TriangleScene& scene, const Options& o, std::vector<std::vector<char>>& keep) {
   RTCScene s = rtcNewScene(device);
   if (o.dynamic) rtcSetSceneFlags(s, RTC_SCENE_FLAG_DYNAMIC);
+  if (o.low) rtcSetSceneBuildQuality(s, RTC_BUILD_QUALITY_LOW);
   const size_t nv = scene.positions.size();
   float* vertices[kMeshes] = {};  // each mesh's vertex x, y, z, at its stride
   size_t stride[kMeshes] = {};
@@ -585,6 +589,7 @@ int main(int argc, char** argv) {
       else if (a == "--dynamic") o.dynamic = true;
       else if (a == "--scatter") o.dynamic = o.scatter = true;
       else if (a == "--refit-quality") o.refit_quality = true;
+      else if (a == "--low") o.low = true;
       else if (a.rfind("--", 0) == 0) throw std::invalid_argument("unknown option " + a);
       else files.push_back(a);
     }
