@@ -47,8 +47,24 @@ class Emitter {
       : bvh_(bvh), out_(out), limits_(limits), callbacks_(callbacks), allocators_(allocators), ws_(ws) {}
 
   EmitResult run(const PrimitiveSet& prims) {
-    plan();
-    reorder(prims.size());
+    const size_t n = prims.size(), nodes = bvh_.nodes.size();
+    // Every node's entries are written (the plan bottom-up, the ranges top-down) before
+    // they are read; nothing is allocated inside the parallel regions below.
+    grow_on_huge_pages(count_, nodes);
+    grow_on_huge_pages(height_, nodes);
+    grow_on_huge_pages(as_leaf_, nodes);
+    grow_on_huge_pages(cost_, nodes);
+    grow_on_huge_pages(first_, nodes);
+    grow_on_huge_pages(ws_.original, n);
+    // The plan on one thread while the others copy the application's primitives (both
+    // stream through memory; the placement needs both).
+#pragma omp parallel
+    {
+#pragma omp single nowait
+      plan();
+      copy_original(n);
+    }
+    reorder();
     void* root = nullptr;
 #pragma omp parallel
 #pragma omp single
@@ -83,12 +99,7 @@ class Emitter {
     // b - 1 of them: each binary node pays a (b - 1)-th of a wide node's traversal cost.
     // Without that, leaves come out larger than Embree's for the same constants.
     binary_traversal_cost_ = double(limits_.traversal_cost) / double(limits_.branching - 1);
-    const size_t n = bvh_.nodes.size();
-    grow_on_huge_pages(count_, n);  // every node's entries are written below before they are read
-    grow_on_huge_pages(height_, n);
-    grow_on_huge_pages(as_leaf_, n);
-    grow_on_huge_pages(cost_, n);
-    for (size_t v = n; v-- > 0;) {
+    for (size_t v = bvh_.nodes.size(); v-- > 0;) {
       const BvhNode& node = bvh_.nodes[v];
       const double leaf_cost_per_prim = double(limits_.intersection_cost) * node.box.surface_area();
       if (node.is_leaf()) {
@@ -121,9 +132,8 @@ class Emitter {
 
   // Top-down: each subtree's range of the primitive array, and the primitives written
   // there in leaf order (the array is the application's; Embree reorders it too).
-  void reorder(size_t n) {
+  void reorder() {
     const size_t nodes = bvh_.nodes.size();
-    grow_on_huge_pages(first_, nodes);  // written top-down before it is read
     first_[0] = 0;
     for (size_t v = 0; v < nodes; ++v) {
       const BvhNode& node = bvh_.nodes[v];
@@ -134,21 +144,24 @@ class Emitter {
         at += count_[c];
       }
     }
-    // The copy in parallel, in blocks (one thread's memcpy of 2.3 million primitives,
-    // 74 MB, took about as long as the loop above).
-    std::vector<RTCBuildPrimitive>& original = ws_.original;
-    grow_on_huge_pages(original, n);
-    constexpr size_t kBlock = size_t(1) << 16;
-#pragma omp parallel for schedule(static)
-    for (int64_t b = 0; b < int64_t((n + kBlock - 1) / kBlock); ++b) {
-      const size_t begin = size_t(b) * kBlock;
-      std::copy(out_ + begin, out_ + std::min(n, begin + kBlock), original.begin() + int64_t(begin));
-    }
+    const std::vector<RTCBuildPrimitive>& original = ws_.original;
 #pragma omp parallel for schedule(dynamic, 4096)
     for (size_t v = 0; v < nodes; ++v) {
       const BvhNode& node = bvh_.nodes[v];
       if (!node.is_leaf()) continue;
       for (uint32_t j = 0; j < node.count; ++j) out_[first_[v] + j] = original[bvh_.prim_indices[node.first + j]];
+    }
+  }
+
+  // The application's primitives as they came, in blocks (one thread's memcpy of 2.3
+  // million primitives, 74 MB, took about as long as a pass over the nodes). Called by every
+  // thread of a parallel region.
+  void copy_original(size_t n) {
+    constexpr size_t kBlock = size_t(1) << 16;
+#pragma omp for schedule(dynamic, 1)
+    for (int64_t b = 0; b < int64_t((n + kBlock - 1) / kBlock); ++b) {
+      const size_t begin = size_t(b) * kBlock;
+      std::copy(out_ + begin, out_ + std::min(n, begin + kBlock), ws_.original.begin() + int64_t(begin));
     }
   }
 
