@@ -1,5 +1,7 @@
 #include "plugin_config.h"
 
+#include "adapters/out/wide_bvh.h"
+
 #include <fmt/format.h>
 
 #include <cstdio>
@@ -116,15 +118,17 @@ BuilderConfig builder_for(const PluginConfig& config, RTCBuildQuality quality, B
   // MEDIUM take the kmbvh configuration nearest to dominating Embree's build of that quality
   // on the shared scenes (LOW: LBVH, faster and cheaper than every k-means preset there);
   // HIGH, where Embree's rtcBuildBVH builds MEDIUM's tree in MEDIUM's time, the k-means
-  // configuration with the lowest SAH cost, the faster of equals. A scene's LOW stays Q1:
-  // LBVH's leaves, chosen by the SAH, hold about two triangles, and the scene layout's blocks
-  // of four then stand half empty (Embree's dynamic_scene: 35% more memory, the layout 50%
-  // slower, the program no faster; plugin/README.md).
-  const bool lbvh_for_low = quality == RTC_BUILD_QUALITY_LOW && !config.kmeans_asked && path == BuildPath::BuilderApi;
+  // configuration with the lowest SAH cost, the faster of equals.
+  const bool lbvh_for_low = quality == RTC_BUILD_QUALITY_LOW && !config.kmeans_asked;
   if (config.builder != BuilderKind::Kmeans || lbvh_for_low) {
     BuilderConfig b;
     b.builder = lbvh_for_low ? BuilderKind::Lbvh : config.builder;
     b.backend = config.backend;
+    // A scene's layout tests its leaves' triangles kPackWidth at a time, a block for about
+    // the price of one triangle: LBVH's leaves, priced a triangle each, would hold about two
+    // and leave the blocks half empty (Embree's dynamic_scene: 35% more memory, the program
+    // no faster than with Q1; priced a block's share, as fast as Q1 is slow: plugin/README.md).
+    if (lbvh_for_low && path == BuildPath::Scene) b.binary.sah.intersection /= float(kPackWidth);
     return b;
   }
   std::string preset = config.preset;

@@ -1,7 +1,7 @@
 // What the plug-in builds with, from the environment (read once per process):
 //   KMBVH_BUILDER  kmeans, any kmbvh builder (sweep-sah, lbvh, hlbvh, atrbvh, ploc,
 //                  Q1..Q5), or embree: every call passed to the real Embree; default: by the
-//                  build quality (builder_for: LBVH for the builder API's LOW, else k-means)
+//                  build quality (builder_for: LBVH for LOW, else k-means)
 //   KMBVH_PRESET   k-means preset Q1..Q5, QA, or one followed by S; default: chosen by the build quality
 //   KMBVH_K, KMBVH_P, KMBVH_I   k-means parameters, overriding the preset's
 //   KMBVH_LOG=1    one line per build (and per scene) on stderr
@@ -63,10 +63,10 @@ const PluginConfig& plugin_config();
 // leaves' triangles four at a time).
 enum class BuildPath { BuilderApi, Scene };
 
-// The builder for one build of the given quality: LOW LBVH through the builder API and
-// k-means Q1 for a scene, MEDIUM k-means Q1GS, HIGH Q2GR, unless the environment names a
-// builder or k-means settings (then LOW's k-means preset is Q1); plugin/README.md has the
-// tables that chose them.
+// The builder for one build of the given quality: LOW LBVH (a scene's with its leaves
+// priced for the layout's blocks of triangles), MEDIUM k-means Q1GS, HIGH Q2GR, unless the
+// environment names a builder or k-means settings (then LOW's k-means preset is Q1);
+// plugin/README.md has the tables that chose them.
 BuilderConfig builder_for(const PluginConfig& config, RTCBuildQuality quality, BuildPath path);
 
 // KMBVH_LOG lines go through here (stderr, one write per line).

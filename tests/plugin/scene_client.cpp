@@ -25,7 +25,7 @@
 // --refit-quality: every mesh asks for refits (RTC_BUILD_QUALITY_REFIT), which Embree and
 //           kmbvh then refit however the motion spoils them.
 // --low:    the scene asks for RTC_BUILD_QUALITY_LOW, as Embree's dynamic_scene tutorial does
-//           (kmbvh then builds with k-means Q1: plugin/README.md, "Build quality").
+//           (kmbvh then builds with LBVH: plugin/README.md, "Build quality").
 #include <embree3/rtcore.h>
 #include <fmt/format.h>
 
