@@ -74,9 +74,14 @@ class SubtreeSplitter {
     const uint32_t k = p.k;
     const NodeRules rules = node_rules(params_);
     Aabb reps[KMax];
-    initialise_representatives<M>(boxes, p.count, k, rules.candidates(k), params_.seed, node_stream(p.begin, p.count),
-                                  reps);
-    if (params_.seeding == Seeding::Cells) seed_from_cells(p, boxes, reps);
+    const auto draw = [&](uint32_t representatives) {
+      initialise_representatives<M>(boxes, p.count, representatives, rules.candidates(k), params_.seed,
+                                    node_stream(p.begin, p.count), reps);
+    };
+    if (params_.seeding == Seeding::Cells)
+      seed_from_cells(p, boxes, reps, draw);
+    else
+      draw(k);
     // The first iteration compares with leftovers of another node, as the level loop's does.
     for (uint32_t iteration = 0; iteration < rules.iterations(k); ++iteration)
       if (rules.settled(update(p, boxes, reps), p.count) && iteration > 0 && rules.until_stable) break;
@@ -125,9 +130,13 @@ class SubtreeSplitter {
     return forced ? 1u : 0u;
   }
 
-  // Cell seeding (seed_cells.h): what the level loop's CellSums pass and mean update do
-  // to a segment of one piece.
-  void seed_from_cells(const Pending& p, const Aabb* boxes, Aabb* reps) const {
+  // Cell seeding (seed_cells.h): what the level loop's paper draws, CellSums pass and mean
+  // update do to a segment of one piece. Only the representatives of empty cells keep their
+  // draws, and the draw of representative r depends on those before it alone, so the draws
+  // stop at the last empty cell (none where every cell has members): the same
+  // representatives for less work. draw(r): the paper's draws of representatives 0..r-1.
+  template <typename Draw>
+  void seed_from_cells(const Pending& p, const Aabb* boxes, Aabb* reps, const Draw& draw) const {
     const CellGrid grid = CellGrid::of(p.box, p.k);
     SumAccumulator<KMax> acc;
     acc.clear(p.k);
@@ -138,6 +147,10 @@ class SubtreeSplitter {
       ++count[c];
       acc.add(c, boxes[x]);
     }
+    uint32_t draws = 0;
+    for (uint32_t c = 0; c < p.k; ++c)
+      if (count[c] == 0) draws = c + 1;
+    if (draws > 0) draw(draws);
     decode_means(p, acc, count, reps);
   }
 
