@@ -17,10 +17,6 @@ namespace kmbvh {
 
 namespace {
 
-uint32_t group_end(const std::vector<uint32_t>& first, size_t g, size_t primitives) {
-  return g + 1 < first.size() ? first[g + 1] : uint32_t(primitives);
-}
-
 // The top tree over the groups' boxes: sweep SAH (docs/design.md §5) with every group a
 // leaf of its own, so that a group's root can take its leaf's place.
 Bvh top_tree(const GroupedBvh& grouped) {

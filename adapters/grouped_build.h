@@ -14,6 +14,11 @@
 
 namespace kmbvh {
 
+// Where group g of a set of `primitives` ends: the next group's first primitive, or the set's end.
+inline uint32_t group_end(const std::vector<uint32_t>& first, size_t g, size_t primitives) {
+  return g + 1 < first.size() ? first[g + 1] : uint32_t(primitives);
+}
+
 struct GroupedBvh {
   std::vector<uint32_t> first;  // group g: primitives [first[g], first[g + 1]) of the set, the last to its end
   std::vector<Bvh> trees;       // group g's tree, its leaves indexing the group's own primitives from 0
@@ -22,9 +27,7 @@ struct GroupedBvh {
   // kept for the next builds as a scene keeps its context.
   std::vector<BuildContext> thread_contexts;
   size_t groups() const { return trees.size(); }
-  size_t group_size(size_t g, size_t primitives) const {
-    return (g + 1 < first.size() ? first[g + 1] : primitives) - first[g];
-  }
+  size_t group_size(size_t g, size_t primitives) const { return group_end(first, g, primitives) - first[g]; }
 };
 
 // Group g's primitives, [first[g], first[g + 1]) of `prims` (the last group to its end).
