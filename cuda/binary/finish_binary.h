@@ -37,6 +37,16 @@ inline void collapse(const BinaryTreeView& tree, CollapseState& state, uint32_t 
 }
 
 #if KMBVH_BACKEND_CPU
+inline Bvh lay_out_by_levels(const BinaryTreeView& tree, CollapseView view, const uint32_t* range_first);
+
+// Trees of this many primitives or more are laid out by the level loop even on the CPU: the
+// sequential pass's scattered reads leave the caches there and its time per primitive
+// doubles, where the level loop's parallel steps stream (LBVH's layout, 2 threads: 1M
+// triangles 34-35 ms sequential against 14-18 by levels, 2.3M 81-82 against 42-48, and 1M
+// on one thread 35-43 against 25-26; 331k 5.2-5.4 against 4.5-6.1, 147k 2.0-2.2 against
+// 2.4-6.9; AMD EPYC, 2026-12-07). Both give the same Bvh byte for byte.
+constexpr uint32_t kLayOutByLevelsFrom = 1u << 19;
+
 // The collapsed tree as a Bvh, breadth-first, in one sequential pass on the CPU: the output
 // is its own queue (output node i is tree node queue[i]; an interior node's two children
 // are appended at its end, which is where the level loop below places them too, so the
@@ -48,6 +58,7 @@ inline void collapse(const BinaryTreeView& tree, CollapseState& state, uint32_t 
 // fetched early so that their misses overlap. range_first: see WriteLevel.
 inline Bvh lay_out(const BinaryTreeView& tree, CollapseView view, const uint32_t* range_first = nullptr) {
   const uint32_t n = tree.n;
+  if (n >= kLayOutByLevelsFrom) return lay_out_by_levels(tree, view, range_first);
   constexpr uint32_t kAhead = 16;  // queue entries fetched ahead
   Buffer<uint32_t> queue_buffer(2 * n - 1);
   uint32_t* queue = ptr(queue_buffer);
@@ -93,9 +104,9 @@ inline Bvh lay_out(const BinaryTreeView& tree, CollapseView view, const uint32_t
   return bvh;
 }
 
-// The portable breadth-first layout, one level per step (the GPU's; the CPU's pass above
-// is checked against it).
-inline Bvh lay_out_by_levels(const BinaryTreeView& tree, CollapseView view, const uint32_t* range_first = nullptr) {
+// The portable breadth-first layout, one level per step (the GPU's, and the CPU's for large
+// trees; the CPU's pass above is checked against it).
+inline Bvh lay_out_by_levels(const BinaryTreeView& tree, CollapseView view, const uint32_t* range_first) {
 #else
 // The collapsed tree as a Bvh, laid out breadth-first one level per step. range_first:
 // see WriteLevel (the leaf order is then the primitive order, copied as it is).
