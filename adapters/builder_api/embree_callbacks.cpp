@@ -18,14 +18,21 @@ namespace kmbvh {
 // whose first touches cost more than the callbacks themselves on this project's machines
 // (docs/design.md §3). On huge pages when they grow.
 struct EmitWorkspace : BuildContext::Workspace {
-  std::vector<uint32_t> count, first, height;
-  std::vector<double> cost;
-  std::vector<uint8_t> as_leaf;
+  // What the emission reads of a node, together: the tree is walked depth first over nodes
+  // laid out breadth first, so each node's visit is a miss or two, not one per array.
+  struct NodePlan {
+    uint32_t count;   // primitives under the node
+    uint32_t first;   // its range's start in the primitive array
+    uint32_t height;  // levels below it, itself included, as it will be emitted
+    uint32_t as_leaf;  // 1: emitted as one leaf
+  };
+  std::vector<NodePlan> plan;
+  std::vector<double> cost;  // the plan's SAH costs, read by the parents' plan only
   std::vector<RTCBuildPrimitive> original;
 
   size_t bytes_held() const override {
-    return (count.capacity() + first.capacity() + height.capacity()) * sizeof(uint32_t) +
-           cost.capacity() * sizeof(double) + as_leaf.capacity() + original.capacity() * sizeof(RTCBuildPrimitive);
+    return plan.capacity() * sizeof(NodePlan) + cost.capacity() * sizeof(double) +
+           original.capacity() * sizeof(RTCBuildPrimitive);
   }
 };
 
@@ -50,11 +57,8 @@ class Emitter {
     const size_t n = prims.size(), nodes = bvh_.nodes.size();
     // Every node's entries are written (the plan bottom-up, the ranges top-down) before
     // they are read; nothing is allocated inside the parallel regions below.
-    grow_on_huge_pages(count_, nodes);
-    grow_on_huge_pages(height_, nodes);
-    grow_on_huge_pages(as_leaf_, nodes);
+    grow_on_huge_pages(plan_, nodes);
     grow_on_huge_pages(cost_, nodes);
-    grow_on_huge_pages(first_, nodes);
     grow_on_huge_pages(ws_.original, n);
     // The plan on one thread while the others copy the application's primitives (both
     // stream through memory; the placement needs both).
@@ -103,29 +107,29 @@ class Emitter {
       const BvhNode& node = bvh_.nodes[v];
       const double leaf_cost_per_prim = double(limits_.intersection_cost) * node.box.surface_area();
       if (node.is_leaf()) {
-        count_[v] = node.count;
-        as_leaf_[v] = 1;
+        plan_[v].count = node.count;
+        plan_[v].as_leaf = 1;
         cost_[v] = leaf_cost_per_prim * node.count;
-        height_[v] = balanced_height(node.count);
+        plan_[v].height = balanced_height(node.count);
         continue;
       }
       uint32_t count = 0, height = 0;
       double inner_cost = binary_traversal_cost_ * node.box.surface_area();
       for (uint32_t c = node.first; c < node.first + node.count; ++c) {
-        count += count_[c];
-        height = std::max(height, height_[c]);
+        count += plan_[c].count;
+        height = std::max(height, plan_[c].height);
         inner_cost += cost_[c];
       }
-      count_[v] = count;
+      plan_[v].count = count;
       const bool fits = count <= limits_.max_leaf;
       if (fits && (count <= limits_.min_leaf || leaf_cost_per_prim * count <= inner_cost)) {
-        as_leaf_[v] = 1;
+        plan_[v].as_leaf = 1;
         cost_[v] = leaf_cost_per_prim * count;
-        height_[v] = 1;
+        plan_[v].height = 1;
       } else {
-        as_leaf_[v] = 0;
+        plan_[v].as_leaf = 0;
         cost_[v] = inner_cost;
-        height_[v] = height + 1;
+        plan_[v].height = height + 1;
       }
     }
   }
@@ -134,14 +138,14 @@ class Emitter {
   // there in leaf order (the array is the application's; Embree reorders it too).
   void reorder() {
     const size_t nodes = bvh_.nodes.size();
-    first_[0] = 0;
+    plan_[0].first = 0;
     for (size_t v = 0; v < nodes; ++v) {
       const BvhNode& node = bvh_.nodes[v];
       if (node.is_leaf()) continue;
-      uint32_t at = first_[v];
+      uint32_t at = plan_[v].first;
       for (uint32_t c = node.first; c < node.first + node.count; ++c) {
-        first_[c] = at;
-        at += count_[c];
+        plan_[c].first = at;
+        at += plan_[c].count;
       }
     }
     const std::vector<RTCBuildPrimitive>& original = ws_.original;
@@ -149,7 +153,8 @@ class Emitter {
     for (size_t v = 0; v < nodes; ++v) {
       const BvhNode& node = bvh_.nodes[v];
       if (!node.is_leaf()) continue;
-      for (uint32_t j = 0; j < node.count; ++j) out_[first_[v] + j] = original[bvh_.prim_indices[node.first + j]];
+      const uint32_t first = plan_[v].first;
+      for (uint32_t j = 0; j < node.count; ++j) out_[first + j] = original[bvh_.prim_indices[node.first + j]];
     }
   }
 
@@ -246,14 +251,15 @@ class Emitter {
 
   void* emit_node(uint32_t v, uint32_t depth) {
     const BvhNode& node = bvh_.nodes[v];
-    const uint32_t count = count_[v];
-    if (as_leaf_[v] && count <= limits_.max_leaf) return emit_leaf(first_[v], count, depth);
-    const bool fits = depth + height_[v] - 1 <= limits_.max_depth;
+    const EmitWorkspace::NodePlan plan = plan_[v];
+    const uint32_t count = plan.count;
+    if (plan.as_leaf && count <= limits_.max_leaf) return emit_leaf(plan.first, count, depth);
+    const bool fits = depth + plan.height - 1 <= limits_.max_depth;
     if (!fits && (node.is_leaf() || depth + balanced_height(count) - 1 <= limits_.max_depth)) {
       ++stats().rebalanced;
-      return emit_range(first_[v], count, depth);
+      return emit_range(plan.first, count, depth);
     }
-    if (node.is_leaf()) return emit_range(first_[v], count, depth);  // a leaf larger than max_leaf
+    if (node.is_leaf()) return emit_range(plan.first, count, depth);  // a leaf larger than max_leaf
 
     if (node.count > limits_.branching)
       throw std::logic_error("emit_to_callbacks: a node has more children than the branching factor");
@@ -267,7 +273,7 @@ class Emitter {
       float best_area = -1.0f;
       for (uint32_t i = 0; i < n; ++i) {
         const BvhNode& k = bvh_.nodes[kids[i]];
-        if (as_leaf_[kids[i]] || k.is_leaf() || n - 1 + k.count > limits_.branching) continue;
+        if (plan_[kids[i]].as_leaf || k.is_leaf() || n - 1 + k.count > limits_.branching) continue;
         if (k.box.surface_area() > best_area) best = int(i), best_area = k.box.surface_area();
       }
       if (best < 0) break;
@@ -280,7 +286,7 @@ class Emitter {
     uint32_t counts[kMaxBranching];
     for (uint32_t i = 0; i < n; ++i) {
       boxes[i] = bvh_.nodes[kids[i]].box;
-      counts[i] = count_[kids[i]];
+      counts[i] = plan_[kids[i]].count;
     }
     return emit_inner(node.box, boxes, counts, n, depth, [&](uint32_t i) { return node_or_fail(kids[i], depth + 1); });
   }
@@ -316,11 +322,8 @@ class Emitter {
   const std::vector<RTCThreadLocalAllocator>& allocators_;
 
   EmitWorkspace& ws_;
-  std::vector<uint32_t>& count_ = ws_.count;
-  std::vector<uint32_t>& first_ = ws_.first;
-  std::vector<uint32_t>& height_ = ws_.height;
+  std::vector<EmitWorkspace::NodePlan>& plan_ = ws_.plan;
   std::vector<double>& cost_ = ws_.cost;
-  std::vector<uint8_t>& as_leaf_ = ws_.as_leaf;
 
   EmitResult result_;
   double binary_traversal_cost_ = 0;
