@@ -70,7 +70,7 @@ PluginConfig read_plugin_config() {
     const BuilderConfig parsed = parse_builder(builder);  // throws for an unknown name
     c.builder = parsed.builder;
     if (parsed.builder == BuilderKind::Kmeans && builder != "kmeans") c.preset = parsed.preset;  // "Q4", "kmeans:Q4"
-    c.kmeans_asked = parsed.builder == BuilderKind::Kmeans;
+    c.builder_named = true;
   }
   if (!env("KMBVH_PRESET").empty()) {
     if (!kmeans_preset(env("KMBVH_PRESET")))
@@ -81,7 +81,7 @@ PluginConfig read_plugin_config() {
   c.p = env_count("KMBVH_P", 1, 1024);
   const std::string i = env("KMBVH_I");
   if (!i.empty()) c.i = env_count("KMBVH_I", 0, 1000) + 1;  // stored +1: 0 iterations is valid
-  c.kmeans_asked = c.kmeans_asked || !c.preset.empty() || c.k || c.p || c.i;
+  c.builder_named = c.builder_named || !c.preset.empty() || c.k || c.p || c.i;
   const std::string backend = env("KMBVH_BACKEND");
   if (backend == "cuda")
     c.backend = Backend::Cuda;
@@ -119,7 +119,7 @@ BuilderConfig builder_for(const PluginConfig& config, RTCBuildQuality quality, B
   // on the shared scenes (LOW: LBVH, faster and cheaper than every k-means preset there);
   // HIGH, where Embree's rtcBuildBVH builds MEDIUM's tree in MEDIUM's time, the k-means
   // configuration with the lowest SAH cost, the faster of equals.
-  const bool lbvh_for_low = quality == RTC_BUILD_QUALITY_LOW && !config.kmeans_asked;
+  const bool lbvh_for_low = quality == RTC_BUILD_QUALITY_LOW && !config.builder_named;
   if (config.builder != BuilderKind::Kmeans || lbvh_for_low) {
     BuilderConfig b;
     b.builder = lbvh_for_low ? BuilderKind::Lbvh : config.builder;

@@ -40,9 +40,9 @@ struct PluginConfig {
   bool pass_through = false;  // KMBVH_BUILDER=embree
   BuilderKind builder = BuilderKind::Kmeans;
   std::string preset;         // empty: by build quality
-  // KMBVH_BUILDER=kmeans (or a preset), KMBVH_PRESET or KMBVH_K/P/I: k-means at every build
-  // quality, LOW included (otherwise LOW builds with LBVH: builder_for).
-  bool kmeans_asked = false;
+  // KMBVH_BUILDER, KMBVH_PRESET or KMBVH_K/P/I set: that builder (k-means for the last
+  // three) at every build quality, LOW included; otherwise LOW builds with LBVH (builder_for).
+  bool builder_named = false;
   uint32_t k = 0, p = 0, i = 0;  // 0: the preset's
   Backend backend = Backend::Cpu;
   bool log = false;
