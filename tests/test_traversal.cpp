@@ -575,6 +575,33 @@ TEST(Traversal, OnePassLayoutRefusesWhatDoesNotFit) {
   const std::vector<PrimitiveId> too_few(3);
   EXPECT_THROW(lay_out_wide<8>(run_builder(parse_builder("Q2"), prims), prims, scene, true, &too_few),
                std::invalid_argument);
+  // Not a tree: the root's two children the same subtree, the larger one, whose leaves then
+  // need more room than the tree's leaves have (the threads that fill packs while the walk
+  // plans them read that room, so it never grows): refused, for every thread count.
+  Bvh twice = run_builder(parse_builder("Q2"), prims);
+  ASSERT_FALSE(twice.root().is_leaf());
+  auto leaves_under = [&](uint32_t node) {
+    uint32_t leaves = 0;
+    for (std::vector<uint32_t> stack{node}; !stack.empty();) {
+      const BvhNode& n = twice.nodes[stack.back()];
+      stack.pop_back();
+      if (n.is_leaf()) {
+        ++leaves;
+      } else {
+        for (uint32_t c = 0; c < n.count; ++c) stack.push_back(n.first + c);
+      }
+    }
+    return leaves;
+  };
+  const uint32_t a = twice.root().first, b = a + 1;
+  ASSERT_NE(leaves_under(a), leaves_under(b));
+  if (leaves_under(a) > leaves_under(b)) twice.nodes[b] = twice.nodes[a];
+  else twice.nodes[a] = twice.nodes[b];
+  for (const int threads : {1, 2, 3}) {
+    set_thread_count(threads);
+    EXPECT_THROW(lay_out_wide<8>(twice, prims, scene, true), std::invalid_argument) << threads << " threads";
+  }
+  set_thread_count(0);
 }
 
 TEST(Traversal, Bvh2NeedsABinaryTree) {

@@ -1,6 +1,9 @@
 #include "wide_layout.h"
 
+#include <immintrin.h>
 #include <omp.h>
+
+#include <atomic>
 
 #include <algorithm>
 #include <limits>
@@ -8,7 +11,6 @@
 #include <string>
 
 #include "collapse_wide.h"
-#include "cuda/core/huge_pages.h"
 #include "cuda/core/parallel_errors.h"
 #include "cuda/traversal/watertight.h"
 
@@ -22,12 +24,18 @@ struct LeafJob {
 };
 
 // The plan: every node written (boxes, counts and links: all but the packs), and each
-// leaf's place among the packs, in the order make_wide_bvh packs them.
+// leaf's place among the packs, in the order make_wide_bvh packs them. The leaves are
+// published as they are planned, so that the other threads fill their packs meanwhile:
+// `leaves` never grows past the room it is given (its elements stay where the fillers
+// read them), nor `packs` past `pack_room`.
 template <int W>
 struct Plan {
   WideBvh<W> out;
   LayoutArray<LeafJob> leaves;
   uint32_t packs = 0;
+  uint32_t pack_room = 0;
+  std::atomic<size_t> published{0};  // leaves[0, published) are planned
+  std::atomic<bool> planned{false};  // and published is final
 };
 
 // Lane `lane` of `node` for source node `c`; a leaf's packs are reserved in order.
@@ -42,24 +50,28 @@ void plan_lane(Plan<W>& plan, WideNode<W>& node, int lane, const Bvh& bvh, uint3
   node.count[lane] = n.is_leaf() ? n.count : 0;
   node.ref[lane] = 0;  // an interior child's index is set when it is written
   if (n.is_leaf()) {
+    const uint32_t packs = (n.count + kPackWidth - 1) / kPackWidth;
+    // Every leaf of a tree is reached once, and the room counts each once: more is a node
+    // reached twice (not a tree), and growing the arrays would move what the fillers read.
+    if (plan.leaves.size() == plan.leaves.capacity() || packs > plan.pack_room - plan.packs)
+      throw std::invalid_argument("lay_out_wide: a node is reached twice (the tree is not a tree)");
     node.ref[lane] = plan.packs;
     plan.leaves.push_back(LeafJob{n.first, n.count, plan.packs});
-    plan.packs += (n.count + kPackWidth - 1) / kPackWidth;
+    plan.packs += packs;
   }
 }
 
-// Depth first, first child first, as lay_out_depth_first walks the collapsed tree.
+// Depth first, first child first, as lay_out_depth_first walks the collapsed tree; the
+// leaves published after each node. `plan` holds the nodes' memory and the leaves' room.
 template <int W>
-Plan<W> plan_layout(const Bvh& bvh, bool collapse, LayoutArray<WideNode<W>> nodes) {
-  Plan<W> plan;
-  plan.out.nodes = std::move(nodes);
+void plan_layout(const Bvh& bvh, bool collapse, Plan<W>& plan) {
   plan.out.nodes.clear();  // keeps its memory
   reserve_with_headroom(plan.out.nodes, bvh.nodes.size() / 2 + 1);  // a wide node per interior node at most: never grown
-  plan.leaves.reserve(bvh.nodes.size() / 2 + 1);
   if (bvh.root().is_leaf()) {  // one leaf: a root with a single lane
     plan.out.nodes.push_back(empty_wide_node<W>());
     plan_lane(plan, plan.out.nodes[0], 0, bvh, 0);
-    return plan;
+    plan.published.store(plan.leaves.size(), std::memory_order_release);
+    return;
   }
   struct Pending {
     uint32_t node, parent, slot, depth;
@@ -83,13 +95,13 @@ Plan<W> plan_layout(const Bvh& bvh, bool collapse, LayoutArray<WideNode<W>> node
     const uint32_t index = uint32_t(plan.out.nodes.size());
     plan.out.nodes.push_back(empty_wide_node<W>());
     for (uint32_t c = 0; c < count; ++c) plan_lane(plan, plan.out.nodes[index], int(c), bvh, children[c]);
+    plan.published.store(plan.leaves.size(), std::memory_order_release);
     if (p.parent != UINT32_MAX) plan.out.nodes[p.parent].ref[p.slot] = index;
     max_depth = std::max(max_depth, p.depth);
     for (uint32_t c = count; c-- > 0;)
       if (!bvh.nodes[children[c]].is_leaf()) stack.push_back({children[c], index, c, p.depth + 1});
   }
   plan.out.stack_size = (W - 1) * max_depth + 1;
-  return plan;
 }
 
 // Each triangle a leaf gathers is a chain of dependent reads at random places (its
@@ -157,25 +169,38 @@ void fill_leaf(TrianglePack* packs, const LeafJob& leaf, const Bvh& bvh, const P
   }
 }
 
-// How many packs the leaves of `bvh` fill: the plan gives every leaf of the tree its packs,
-// and collapsing keeps the leaves as they are.
-uint32_t count_packs(const Bvh& bvh) {
-  uint64_t packs = 0;
-#pragma omp parallel for reduction(+ : packs) schedule(static)
+// How many leaves `bvh` has and how many packs they fill: the plan gives every leaf of the
+// tree its packs, and collapsing keeps the leaves as they are.
+struct LeafCount {
+  size_t leaves = 0;
+  uint32_t packs = 0;
+};
+LeafCount count_leaves(const Bvh& bvh) {
+  uint64_t leaves = 0, packs = 0;
+#pragma omp parallel for reduction(+ : leaves, packs) schedule(static)
   for (int64_t i = 0; i < int64_t(bvh.nodes.size()); ++i) {
     const BvhNode& n = bvh.nodes[size_t(i)];
-    if (n.is_leaf()) packs += (n.count + kPackWidth - 1) / kPackWidth;
+    if (n.is_leaf()) ++leaves, packs += (n.count + kPackWidth - 1) / kPackWidth;
   }
-  return uint32_t(packs);
+  if (packs > UINT32_MAX) throw std::invalid_argument("lay_out_wide: more triangle packs than 32-bit references reach");
+  return LeafCount{size_t(leaves), uint32_t(packs)};
 }
 
-// Faults in thread `t`'s share (of `n`) of the pages of `bytes` at `p` (huge_pages.h:
-// populate_pages): the kernel's allocation and zeroing of the pages then happen here and
-// not in the fill.
-void populate_share(void* p, size_t bytes, int t, int n) {
-  const size_t share = (bytes + size_t(n) - 1) / size_t(n);
-  const size_t begin = std::min(bytes, share * size_t(t)), end = std::min(bytes, begin + share);
-  populate_pages(static_cast<char*>(p) + begin, end - begin);
+// Fills the packs of plan.leaves[begin, end), fetching the leaves a few ahead (GatherAhead).
+template <int W>
+void fill_leaves(const Plan<W>& plan, size_t begin, size_t end, TrianglePack* packs, const Bvh& bvh,
+                 const PrimitiveSet& prims, const TriangleScene& scene, const std::vector<PrimitiveId>* reported_ids) {
+  const GatherAhead ahead{bvh, prims, scene};
+  const LeafJob* leaves = plan.leaves.data();
+  for (size_t l = begin; l < std::min(end, begin + GatherAhead::kIds); ++l) ahead.ids(leaves[l]);
+  for (size_t l = begin; l < std::min(end, begin + GatherAhead::kTriangles); ++l) ahead.triangles(leaves[l]);
+  for (size_t l = begin; l < std::min(end, begin + GatherAhead::kPositions); ++l) ahead.positions(leaves[l]);
+  for (size_t l = begin; l < end; ++l) {
+    if (l + GatherAhead::kIds < end) ahead.ids(leaves[l + GatherAhead::kIds]);
+    if (l + GatherAhead::kTriangles < end) ahead.triangles(leaves[l + GatherAhead::kTriangles]);
+    if (l + GatherAhead::kPositions < end) ahead.positions(leaves[l + GatherAhead::kPositions]);
+    fill_leaf(packs + leaves[l].first_pack, leaves[l], bvh, prims, scene, reported_ids);
+  }
 }
 
 }  // namespace
@@ -186,55 +211,53 @@ WideBvh<W> lay_out_wide(const Bvh& bvh, const PrimitiveSet& prims, const Triangl
   if (reported_ids && reported_ids->size() != scene.triangles.size())
     throw std::invalid_argument("lay_out_wide: reported_ids needs one id per triangle of the scene");
   if (bvh.empty() || (bvh.root().is_leaf() && bvh.root().count == 0)) return WideBvh<W>();
-  // The plan is a sequential walk; while one thread makes it, the others take the first
-  // touches of the packs' pages (conference's 18 MB: 5.3 ms of faults and zeroing on this
-  // project's machines, even on huge pages), which the fill would otherwise wait for.
+  // The plan is a sequential walk (its time: one dependent read of the source tree a node);
+  // while thread 0 makes it, the others fill the packs of the leaves it has planned, a chunk
+  // at a time, and thread 0 joins them once it is done (conference, Q1's tree, 2 threads:
+  // plan 5-6 ms, then fill 5 ms, before).
   LayoutArray<TrianglePack> packs;
-  LayoutArray<WideNode<W>> nodes;
+  Plan<W> plan;
   if (reuse) {
     packs = std::move(reuse->packs);
-    nodes = std::move(reuse->nodes);
+    plan.out.nodes = std::move(reuse->nodes);
     *reuse = WideBvh<W>();
     packs.clear();
   }
-  const size_t touched = packs.capacity();  // pages a previous layout wrote: no fault to take
-  const uint32_t pack_count = count_packs(bvh);
-  reserve_with_headroom(packs, pack_count);
-  packs.resize(pack_count);  // not zeroed (layout_memory.h): fill_leaf writes each pack whole
-  Plan<W> plan;
+  const LeafCount counted = count_leaves(bvh);
+  reserve_with_headroom(packs, counted.packs);
+  packs.resize(counted.packs);  // not zeroed (layout_memory.h): fill_leaf writes each pack whole
+  plan.leaves.reserve(counted.leaves);
+  plan.pack_room = counted.packs;
+  constexpr size_t kChunk = 512;
+  std::atomic<size_t> next_chunk{0};
   ParallelErrors errors;
 #pragma omp parallel
   {
-    if (omp_get_thread_num() == 0)
-      errors.capture([&] { plan = plan_layout<W>(bvh, collapse, std::move(nodes)); });
-    else if (packs.size() > touched)
-      populate_share(packs.data(), packs.size() * sizeof(TrianglePack), omp_get_thread_num() - 1,
-                     omp_get_num_threads() - 1);
+    if (omp_get_thread_num() == 0) {
+      errors.capture([&] { plan_layout<W>(bvh, collapse, plan); });
+      plan.planned.store(true, std::memory_order_release);
+    }
+    for (;;) {
+      const size_t begin = next_chunk.fetch_add(1, std::memory_order_relaxed) * kChunk;
+      size_t end = begin + kChunk;
+      for (;;) {  // until the chunk is planned, or the plan is over and published final
+        const bool over = plan.planned.load(std::memory_order_acquire);
+        const size_t ready = plan.published.load(std::memory_order_acquire);
+        if (ready >= end) break;
+        if (over) {
+          end = ready;
+          break;
+        }
+        _mm_pause();
+      }
+      if (begin >= end) break;
+      errors.capture([&] { fill_leaves(plan, begin, end, packs.data(), bvh, prims, scene, reported_ids); });
+    }
   }
   errors.rethrow();
   WideBvh<W>& out = plan.out;
   out.packs = std::move(packs);
   if (out.packs.size() != plan.packs) out.packs.resize(plan.packs);  // a tree with unreachable leaves
-  const GatherAhead ahead{bvh, prims, scene};
-  constexpr size_t kChunk = 512;
-  const size_t leaves = plan.leaves.size();
-#pragma omp parallel for schedule(dynamic, 1)
-  for (size_t c = 0; c < (leaves + kChunk - 1) / kChunk; ++c) {
-    errors.capture([&] {
-      const size_t begin = c * kChunk, end = std::min(leaves, begin + kChunk);
-      for (size_t l = begin; l < std::min(end, begin + GatherAhead::kIds); ++l) ahead.ids(plan.leaves[l]);
-      for (size_t l = begin; l < std::min(end, begin + GatherAhead::kTriangles); ++l) ahead.triangles(plan.leaves[l]);
-      for (size_t l = begin; l < std::min(end, begin + GatherAhead::kPositions); ++l) ahead.positions(plan.leaves[l]);
-      for (size_t l = begin; l < end; ++l) {
-        if (l + GatherAhead::kIds < end) ahead.ids(plan.leaves[l + GatherAhead::kIds]);
-        if (l + GatherAhead::kTriangles < end) ahead.triangles(plan.leaves[l + GatherAhead::kTriangles]);
-        if (l + GatherAhead::kPositions < end) ahead.positions(plan.leaves[l + GatherAhead::kPositions]);
-        const LeafJob& job = plan.leaves[l];
-        fill_leaf(&out.packs[job.first_pack], job, bvh, prims, scene, reported_ids);
-      }
-    });
-  }
-  errors.rethrow();
   return std::move(plan.out);
 }
 
