@@ -176,6 +176,13 @@ TEST(Cli, TraceComparesWithEmbree) {
   ASSERT_EQ(j["layouts"].size(), 3u);
   for (const auto& layout : j["layouts"]) {
     ASSERT_EQ(layout["kinds"].size(), 3u);
+    EXPECT_GT(layout["layout_ms"].get<double>(), 0.0);
+    // A wide layout is made again in the first one's memory (as a scene committed again),
+    // timed, and that one traces the rays compared above.
+    EXPECT_EQ(layout.contains("relayout_ms"), layout["layout"] != "bvh2");
+    if (layout.contains("relayout_ms")) {
+      EXPECT_GT(layout["relayout_ms"].get<double>(), 0.0);
+    }
     for (const auto& kind : layout["kinds"]) {
       EXPECT_EQ(kind["rays"], 3000);
       EXPECT_GT(kind["kmbvh_mrays_per_s"].get<double>(), 0.0);
