@@ -22,7 +22,7 @@ struct AccelReport {
   std::string builder;  // the builder's label, "kmeans Q3"
   size_t triangles = 0, meshes = 0, dropped = 0;
   double build_ms = 0, layout_ms = 0;  // build_ms: the refit's, for a refit (builder "refit of ...")
-  double sah = 0;
+  double sah = 0;  // the traced tree's, measured only for the log and the A/B mode (KMBVH_LOG, KMBVH_AB)
   uint64_t allocations = 0;  // backend memory the build allocated (none when the scene's context held enough)
   std::string isa;  // the traversal kernel's instruction set (adapters/out/cpu_isa.h)
 };
