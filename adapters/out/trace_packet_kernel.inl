@@ -78,6 +78,10 @@ inline float fold_lanes(V v, Op op) {
   return op(h, __builtin_shufflevector(h, h, 1, 0, 3, 2))[0];
 }
 
+// The least and the greatest of a packet's lanes.
+inline float least_lane(vfk v) { return fold_lanes(v, [](auto a, auto b) { return vmin(a, b); }); }
+inline float greatest_lane(vfk v) { return fold_lanes(v, [](auto a, auto b) { return vmax(a, b); }); }
+
 // a where mask is set, b elsewhere.
 inline vfk select(vik mask, vfk a, vfk b) { return vfk((vik(a) & mask) | (vik(b) & ~mask)); }
 
@@ -129,25 +133,23 @@ struct PacketBounds {
 
   PacketBounds(const PacketRays& r, unsigned alive) {
     constexpr float kInf = std::numeric_limits<float>::infinity();
-    auto lo_of = [](vfk v) { return fold_lanes(v, [](auto a, auto b) { return vmin(a, b); }); };
-    auto hi_of = [](vfk v) { return fold_lanes(v, [](auto a, auto b) { return vmax(a, b); }); };
     // Where a node's lanes take two registers (the SSE4.2 region's BVH8), GCC compiles the
     // test lane by lane, and it cost more than it saved (conference's primary packets 5.4
     // -> 3.4 Mrays/s): off.
     if (kSplitLanes<V> || !alive) return;
     for (int d = 0; d < 3; ++d) {
-      const float inv_lo = lo_of(r.inv[d]), inv_hi = hi_of(r.inv[d]);
-      const float org_lo = lo_of(r.org[d]), org_hi = hi_of(r.org[d]);
+      const float inv_lo = least_lane(r.inv[d]), inv_hi = greatest_lane(r.inv[d]);
+      const float org_lo = least_lane(r.org[d]), org_hi = greatest_lane(r.org[d]);
       const bool negative = inv_hi < 0.0f;
       if (!negative && !(inv_lo > 0.0f)) return;  // mixed signs
       if (!(std::fabs(org_lo) < kInf && std::fabs(org_hi) < kInf)) return;
       omin[d] = splat<V>(negative ? -org_hi : org_lo), omax[d] = splat<V>(negative ? -org_lo : org_hi);
       imin[d] = splat<V>(negative ? -inv_hi : inv_lo), imax[d] = splat<V>(negative ? -inv_lo : inv_hi);
       flip[d] = splat<V>(negative ? -0.0f : 0.0f);
-      near[d] = (negative ? 3 * W : 0) + d * W;  // hi follows lo in WideNode
-      far[d] = (negative ? 0 : 3 * W) + d * W;
+      near[d] = WideRay<W>::near_plane(inv_hi, d);  // the single-ray test's, by the shared sign
+      far[d] = WideRay<W>::far_plane(inv_hi, d);
     }
-    tnear = lo_of(r.tnear);
+    tnear = least_lane(r.tnear);
     on = true;
   }
 
@@ -201,8 +203,7 @@ struct PacketStacks {
 // The nearest entry among the rays `rays` (for ordering children: the packet goes first
 // where its nearest ray goes first).
 inline float nearest_entry(vfk entry, vik rays) {
-  const vfk v = select(rays, entry, splatk(std::numeric_limits<float>::infinity()));
-  return fold_lanes(v, [](auto a, auto b) { return vmin(a, b); });
+  return least_lane(select(rays, entry, splatk(std::numeric_limits<float>::infinity())));
 }
 
 // The packet's rays field by field, lane i holding rays[i]'s (transposed once, so that the
@@ -562,7 +563,7 @@ void traverse_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Hit
   // ray of the packet may enter (PacketBounds).
   auto children_to_test = [&](const WideNode<W>& n) __attribute__((always_inline)) {
     unsigned lanes = less_equal_bits(load<W>(n.lo[0]), load<W>(n.hi[0]));
-    if (bounds.on) lanes &= bounds.may_enter(n, fold_lanes(cull, [](auto a, auto b) { return vmax(a, b); }));
+    if (bounds.on) lanes &= bounds.may_enter(n, greatest_lane(cull));
     return lanes;
   };
   uint32_t sp = 0;

@@ -24,10 +24,10 @@ namespace kmbvh {
 // triangle's id by reported_ids[id.prim] (Embree's ids of a flattened multi-mesh scene).
 // Throws std::invalid_argument for a node of more than W children, a primitive that is
 // not in the scene, or a node reached twice where its leaves need more packs than the
-// tree's leaves fill (a graph that is not a tree). reuse, when given, is a layout no longer traced whose arrays the new one
-// takes over (and leaves empty): a scene laid out again at every commit writes into memory
-// it has touched before instead of faulting in fresh pages (layout_memory.h). The result is
-// the same either way.
+// tree's leaves fill (a graph that is not a tree). reuse, when given, is a layout no longer
+// traced whose arrays the new one takes over (and leaves empty): a scene laid out again at
+// every commit writes into memory it has touched before instead of faulting in fresh pages
+// (layout_memory.h). The result is the same either way.
 template <int W>
 WideBvh<W> lay_out_wide(const Bvh& bvh, const PrimitiveSet& prims, const TriangleScene& scene, bool collapse,
                         const std::vector<PrimitiveId>* reported_ids = nullptr, WideBvh<W>* reuse = nullptr);
