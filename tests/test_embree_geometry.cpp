@@ -11,6 +11,7 @@
 #include "adapters/builder_registry.h"
 #include "adapters/embree/embree_geometry.h"
 #include "adapters/out/tracer.h"
+#include "cuda/core/threads.h"
 #include "support/scenes.h"
 
 namespace kmbvh {
@@ -96,6 +97,102 @@ TEST(EmbreeGeometry, FlattenedOverAnEarlierCommitSaysWhetherItsTrianglesAreTheSa
   FlattenedMeshes none = flatten_triangle_meshes({}, &again, &same);
   EXPECT_FALSE(same);
   EXPECT_TRUE(none.scene.triangles.empty() && none.ids.empty());
+}
+
+// What flatten_triangle_meshes gives, written as the plain sequential rule: mesh by mesh,
+// each triangle in primID order, kept when its indices are in range and its vertices finite
+// and within Embree's range (a mesh without triangles adds no vertices).
+FlattenedMeshes flattened_one_by_one(const std::vector<EmbreeTriangleMesh>& meshes) {
+  FlattenedMeshes out;
+  for (const EmbreeTriangleMesh& m : meshes) {
+    if (m.indices.count == 0) continue;
+    const auto base = uint32_t(out.scene.positions.size());
+    const auto* p = static_cast<const float*>(m.vertices.data);
+    for (size_t v = 0; v < m.vertices.count; ++v)
+      out.scene.positions.emplace_back(p[3 * v], p[3 * v + 1], p[3 * v + 2]);
+    const auto usable = [&](uint32_t v) {
+      const Vec3 q = out.scene.positions[base + v];
+      return std::isfinite(q.x) && std::isfinite(q.y) && std::isfinite(q.z) && std::fabs(q.x) < 1.8e18f &&
+             std::fabs(q.y) < 1.8e18f && std::fabs(q.z) < 1.8e18f;
+    };
+    const auto* t = static_cast<const uint32_t*>(m.indices.data);
+    for (uint32_t i = 0; i < m.indices.count; ++i) {
+      const uint32_t a = t[3 * i], b = t[3 * i + 1], c = t[3 * i + 2];
+      if (a >= m.vertices.count || b >= m.vertices.count || c >= m.vertices.count || !usable(a) || !usable(b) ||
+          !usable(c)) {
+        ++out.dropped;
+        continue;
+      }
+      out.scene.triangles.push_back({base + a, base + b, base + c});
+      out.ids.push_back(PrimitiveId{m.geom_id, i});
+    }
+  }
+  return out;
+}
+
+// Meshes large enough to be flattened in several chunks on every thread, with dropped
+// triangles in some chunks and not in others: the same arrays as the sequential rule, at one
+// and two threads, and over an earlier flattening the same answer to "are the triangles the
+// same" whichever chunk a change falls in.
+TEST(EmbreeGeometry, FlattensInChunksAsOneSequentialPassWould) {
+  const auto grid = [](uint32_t side, float z, std::vector<float>& v, std::vector<uint32_t>& t) {
+    for (uint32_t y = 0; y <= side; ++y)
+      for (uint32_t x = 0; x <= side; ++x) v.insert(v.end(), {float(x), float(y), z});
+    for (uint32_t y = 0; y < side; ++y)
+      for (uint32_t x = 0; x < side; ++x) {
+        const uint32_t a = y * (side + 1) + x;
+        t.insert(t.end(), {a, a + 1, a + side + 1, a + 1, a + side + 2, a + side + 1});
+      }
+  };
+  std::vector<float> va, vb;
+  std::vector<uint32_t> ta, tb;
+  grid(150, 0.0f, va, ta);  // 45,000 triangles: three chunks and a part
+  grid(100, 1.0f, vb, tb);  // 20,000: a chunk and a part
+  va[3 * 700 + 1] = std::numeric_limits<float>::quiet_NaN();  // drops triangles in the first chunk
+  ta[3 * 40000 + 2] = 1u << 30;                                // and one in the third
+  vb[3 * 8000 + 2] = 3e18f;                                    // beyond Embree's range
+  const auto mesh = [](uint32_t id, const std::vector<float>& v, const std::vector<uint32_t>& t) {
+    return EmbreeTriangleMesh{
+        id, {v.data(), RTC_FORMAT_FLOAT3, 12, v.size() / 3}, {t.data(), RTC_FORMAT_UINT3, 12, t.size() / 3}};
+  };
+  const std::vector<EmbreeTriangleMesh> meshes{mesh(2, va, ta), EmbreeTriangleMesh{5, {}, {}}, mesh(6, vb, tb)};
+  ASSERT_GT(flattened_one_by_one(meshes).dropped, 0u);
+  const auto expect_sequential = [&](const FlattenedMeshes& got) {
+    const FlattenedMeshes expected = flattened_one_by_one(meshes);
+    EXPECT_EQ(got.dropped, expected.dropped);
+    ASSERT_EQ(got.scene.positions.size(), expected.scene.positions.size());
+    for (size_t i = 0; i < got.scene.positions.size(); ++i)
+      ASSERT_EQ(std::memcmp(&got.scene.positions[i], &expected.scene.positions[i], sizeof(Vec3)), 0) << i;
+    ASSERT_EQ(got.scene.triangles, expected.scene.triangles);
+    ASSERT_EQ(got.ids.size(), expected.ids.size());
+    for (size_t i = 0; i < got.ids.size(); ++i)
+      ASSERT_TRUE(got.ids[i].geom == expected.ids[i].geom && got.ids[i].prim == expected.ids[i].prim) << i;
+  };
+  const int threads_before = thread_count();
+  for (const int threads : {1, 2}) {
+    set_thread_count(threads);
+    SCOPED_TRACE(threads);
+    FlattenedMeshes earlier = flatten_triangle_meshes(meshes);
+    expect_sequential(earlier);
+    bool same = false;
+    va[3 * 20000] += 0.25f;  // a vertex moved
+    FlattenedMeshes moved = flatten_triangle_meshes(meshes, &earlier, &same);
+    EXPECT_TRUE(same);
+    expect_sequential(moved);
+    va[3 * 20000] -= 0.25f;
+    const uint32_t index = tb[3 * 19000];
+    tb[3 * 19000] = tb[3 * 19000 + 1];  // an index changed, in the second mesh's second chunk
+    FlattenedMeshes reindexed = flatten_triangle_meshes(meshes, &moved, &same);
+    EXPECT_FALSE(same);
+    expect_sequential(reindexed);
+    tb[3 * 19000] = index;
+    FlattenedMeshes back = flatten_triangle_meshes(meshes, &reindexed, &same);
+    EXPECT_FALSE(same);  // compared with the reindexed one
+    FlattenedMeshes again = flatten_triangle_meshes(meshes, &back, &same);
+    EXPECT_TRUE(same);
+    expect_sequential(again);
+  }
+  set_thread_count(threads_before);
 }
 
 TEST(EmbreeGeometry, RefusesFormatsItCannotRead) {
