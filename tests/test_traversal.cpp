@@ -503,6 +503,17 @@ TEST(Traversal, OnePassLayoutIsTheReferenceByteForByte) {
   std::vector<PrimitiveId> ids(scene.triangles.size());
   for (size_t t = 0; t < ids.size(); ++t) ids[t] = PrimitiveId{uint32_t(t % 3), uint32_t(t / 3)};
   expect_one_pass_layout_is_the_reference<8>(run_builder(parse_builder("Q3"), prims), prims, scene, &ids, "reported ids");
+  // Sets that are not the scene's triangles in order, which the fill reads through their ids:
+  // two primitives swapped, and ids that name another geometry.
+  PrimitiveSet swapped = prims;
+  std::swap(swapped.boxes[5], swapped.boxes[17]);
+  std::swap(swapped.ids[5], swapped.ids[17]);
+  expect_one_pass_layout_is_the_reference<8>(run_builder(parse_builder("lbvh"), swapped), swapped, scene, nullptr,
+                                             "two primitives swapped");
+  PrimitiveSet other_geometry = prims;
+  for (PrimitiveId& id : other_geometry.ids) id.geom = 1;
+  expect_one_pass_layout_is_the_reference<8>(run_builder(parse_builder("lbvh"), other_geometry), other_geometry, scene,
+                                             nullptr, "another geometry's ids");
   const TriangleScene few = test::random_triangles(3, 37);
   const PrimitiveSet few_prims = make_primitive_set(few);
   expect_one_pass_layout_is_the_reference<8>(run_builder(parse_builder("Q2"), few_prims), few_prims, few, nullptr,

@@ -103,15 +103,40 @@ void plan_layout(const Bvh& bvh, bool collapse, Plan<W>& plan) {
   plan.out.stack_size = (W - 1) * max_depth + 1;
 }
 
+// The scene id of primitive j of the set: prims.ids[j], or {0, j} where the set is the
+// scene's triangles in order (`in_order`: ids_in_scene_order), which spares the fill one
+// random read a triangle.
+struct SetIds {
+  const PrimitiveSet& prims;
+  bool in_order;
+  PrimitiveId operator[](uint32_t j) const { return in_order ? PrimitiveId{0, j} : prims.ids[j]; }
+};
+
+// Whether primitive j of `prims` is triangle j of `scene` (id {0, j}) for every j: the set
+// make_primitive_set makes where no triangle is dropped, the scene path's and the tools'.
+// One parallel pass over the ids (8 bytes a triangle), where the fill would read each at a
+// random place (conference@4, 1.3M triangles, LBVH's tree, 2 threads, AVX2: the layout
+// made again in its memory 43-46 -> 38-41 ms).
+bool ids_in_scene_order(const PrimitiveSet& prims, const TriangleScene& scene) {
+  if (prims.size() != scene.triangles.size()) return false;
+  const PrimitiveId* ids = prims.ids.data();
+  uint64_t out_of_order = 0;
+#pragma omp parallel for reduction(+ : out_of_order) schedule(static)
+  for (int64_t j = 0; j < int64_t(prims.size()); ++j)
+    out_of_order += ids[j].geom != 0 || ids[j].prim != uint32_t(j) ? 1 : 0;
+  return out_of_order == 0;
+}
+
 // Each triangle a leaf gathers is a chain of dependent reads at random places (its
-// primitive's id, the triangle's vertex indices, the three positions), a cache miss each:
-// the leaves a few ahead are fetched in stages, each stage reading what the one before
-// fetched, so that the misses of many triangles overlap (conference, Q1's tree, 2 threads:
-// the fill from 7.3 to 5.6 ms once its pages are touched).
+// primitive's id, unless the ids are in order, the triangle's vertex indices and reported
+// id, the three positions), a cache miss each: the leaves a few ahead are fetched in stages, each stage
+// reading what the one before fetched, so that the misses of many triangles overlap
+// (conference, Q1's tree, 2 threads: the fill from 7.3 to 5.6 ms once its pages are touched).
 struct GatherAhead {
   const Bvh& bvh;
-  const PrimitiveSet& prims;
+  SetIds set_ids;
   const TriangleScene& scene;
+  const std::vector<PrimitiveId>* reported_ids;
   static constexpr uint32_t kIds = 6, kTriangles = 4, kPositions = 2;  // leaves ahead
 
   // f(j) for each primitive j of the leaf (a position in the PrimitiveSet).
@@ -119,20 +144,23 @@ struct GatherAhead {
   void each(const LeafJob& leaf, Each&& f) const {
     for (uint32_t i = 0; i < leaf.count; ++i) {
       const uint32_t j = bvh.prim_indices[leaf.first + i];
-      if (j < prims.size()) f(j);
+      if (j < set_ids.prims.size()) f(j);
     }
   }
   void ids(const LeafJob& leaf) const {
-    each(leaf, [&](uint32_t j) { __builtin_prefetch(&prims.ids[j]); });
+    if (!set_ids.in_order) each(leaf, [&](uint32_t j) { __builtin_prefetch(&set_ids.prims.ids[j]); });
   }
   void triangles(const LeafJob& leaf) const {
     each(leaf, [&](uint32_t j) {
-      if (prims.ids[j].prim < scene.triangles.size()) __builtin_prefetch(&scene.triangles[prims.ids[j].prim]);
+      const uint32_t t = set_ids[j].prim;
+      if (t >= scene.triangles.size()) return;
+      __builtin_prefetch(&scene.triangles[t]);
+      if (reported_ids) __builtin_prefetch(&(*reported_ids)[t]);
     });
   }
   void positions(const LeafJob& leaf) const {
     each(leaf, [&](uint32_t j) {
-      const PrimitiveId id = prims.ids[j];
+      const PrimitiveId id = set_ids[j];
       if (id.prim >= scene.triangles.size()) return;
       const Triangle& t = scene.triangles[id.prim];
       for (int v = 0; v < 3; ++v) __builtin_prefetch(&scene.positions[t[v]]);
@@ -142,8 +170,8 @@ struct GatherAhead {
 
 // The packs of one leaf, gathered from the scene (leaf_triangles.cpp and wide_bvh.cpp's
 // pack_leaf in one step: degenerate triangles and unused slots as NaN, never hit).
-void fill_leaf(TrianglePack* packs, const LeafJob& leaf, const Bvh& bvh, const PrimitiveSet& prims,
-               const TriangleScene& scene, const std::vector<PrimitiveId>* reported_ids) {
+void fill_leaf(TrianglePack* packs, const LeafJob& leaf, const Bvh& bvh, SetIds set_ids, const TriangleScene& scene,
+               const std::vector<PrimitiveId>* reported_ids) {
   const float nan = std::numeric_limits<float>::quiet_NaN();
   for (uint32_t i = 0; i < leaf.count; i += kPackWidth) {
     TrianglePack& pack = packs[i / kPackWidth];
@@ -152,8 +180,9 @@ void fill_leaf(TrianglePack* packs, const LeafJob& leaf, const Bvh& bvh, const P
       PrimitiveId id{kInvalidId, kInvalidId};
       if (i + slot < leaf.count) {
         const uint32_t j = bvh.prim_indices[leaf.first + i + slot];
-        if (j >= prims.size()) throw std::invalid_argument("lay_out_wide: a leaf names a primitive the set does not have");
-        id = prims.ids[j];
+        if (j >= set_ids.prims.size())
+          throw std::invalid_argument("lay_out_wide: a leaf names a primitive the set does not have");
+        id = set_ids[j];
         if (id.prim >= scene.triangles.size())
           throw std::invalid_argument("lay_out_wide: a primitive is not in the scene");
         const Triangle& t = scene.triangles[id.prim];
@@ -187,9 +216,9 @@ LeafCount count_leaves(const Bvh& bvh) {
 
 // Fills the packs of plan.leaves[begin, end), fetching the leaves a few ahead (GatherAhead).
 template <int W>
-void fill_leaves(const Plan<W>& plan, size_t begin, size_t end, TrianglePack* packs, const Bvh& bvh,
-                 const PrimitiveSet& prims, const TriangleScene& scene, const std::vector<PrimitiveId>* reported_ids) {
-  const GatherAhead ahead{bvh, prims, scene};
+void fill_leaves(const Plan<W>& plan, size_t begin, size_t end, TrianglePack* packs, const Bvh& bvh, SetIds set_ids,
+                 const TriangleScene& scene, const std::vector<PrimitiveId>* reported_ids) {
+  const GatherAhead ahead{bvh, set_ids, scene, reported_ids};
   const LeafJob* leaves = plan.leaves.data();
   for (size_t l = begin; l < std::min(end, begin + GatherAhead::kIds); ++l) ahead.ids(leaves[l]);
   for (size_t l = begin; l < std::min(end, begin + GatherAhead::kTriangles); ++l) ahead.triangles(leaves[l]);
@@ -198,7 +227,7 @@ void fill_leaves(const Plan<W>& plan, size_t begin, size_t end, TrianglePack* pa
     if (l + GatherAhead::kIds < end) ahead.ids(leaves[l + GatherAhead::kIds]);
     if (l + GatherAhead::kTriangles < end) ahead.triangles(leaves[l + GatherAhead::kTriangles]);
     if (l + GatherAhead::kPositions < end) ahead.positions(leaves[l + GatherAhead::kPositions]);
-    fill_leaf(packs + leaves[l].first_pack, leaves[l], bvh, prims, scene, reported_ids);
+    fill_leaf(packs + leaves[l].first_pack, leaves[l], bvh, set_ids, scene, reported_ids);
   }
 }
 
@@ -224,6 +253,7 @@ WideBvh<W> lay_out_wide(const Bvh& bvh, const PrimitiveSet& prims, const Triangl
     packs.clear();
   }
   const LeafCount counted = count_leaves(bvh);
+  const SetIds set_ids{prims, ids_in_scene_order(prims, scene)};
   reserve_with_headroom(packs, counted.packs);
   packs.resize(counted.packs);  // not zeroed (layout_memory.h): fill_leaf writes each pack whole
   plan.leaves.reserve(counted.leaves);
@@ -251,7 +281,7 @@ WideBvh<W> lay_out_wide(const Bvh& bvh, const PrimitiveSet& prims, const Triangl
         _mm_pause();
       }
       if (begin >= end) break;
-      errors.capture([&] { fill_leaves(plan, begin, end, packs.data(), bvh, prims, scene, reported_ids); });
+      errors.capture([&] { fill_leaves(plan, begin, end, packs.data(), bvh, set_ids, scene, reported_ids); });
     }
   }
   errors.rethrow();

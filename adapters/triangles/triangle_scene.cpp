@@ -63,8 +63,15 @@ PrimitiveSet make_primitive_set(const TriangleScene& scene, size_t* dropped, Pri
 #pragma omp parallel for reduction(+ : skipped)
   for (int64_t i = 0; i < int64_t(n); ++i) {
     const auto t = size_t(i);
-    skipped += finite(t) ? 0 : 1;
-    set.boxes[t] = scene.triangle_box(t);
+    // Each vertex read once, for the test and the box (triangle_box's operations, inline).
+    const Triangle& v = scene.triangles[t];
+    const Vec3 a = scene.positions[v[0]], b = scene.positions[v[1]], c = scene.positions[v[2]];
+    skipped += is_finite(a) && is_finite(b) && is_finite(c) ? 0 : 1;
+    Aabb box;
+    box.grow(a);
+    box.grow(b);
+    box.grow(c);
+    set.boxes[t] = box;
     set.ids[t] = PrimitiveId{0, static_cast<uint32_t>(t)};
   }
   if (skipped) {
