@@ -77,6 +77,7 @@ void build_group(GroupedBvh& grouped, size_t g, const BuilderConfig& config, con
                  BuildInfo* info, BuildContext* context) {
   BuildInfo group_info;
   BuildInfo* counted = info ? &group_info : nullptr;
+  if (context) context->lend_tree(std::move(grouped.trees[g]));  // the new tree takes its memory
   grouped.trees[g] = grouped.groups() == 1 ? run_builder(config, prims, counted, context)  // no copy of the set
                                            : run_builder(config, group_primitives(prims, grouped.first, g), counted, context);
   grouped.built_sah[g] = sah_cost(grouped.trees[g]);

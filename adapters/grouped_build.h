@@ -46,7 +46,9 @@ GroupedBvh build_grouped(const BuilderConfig& config, const PrimitiveSet& prims,
 // (`thread_contexts`): a k-means build of a mesh's 50-70k triangles runs 1.5 times as fast
 // on two threads as on one, so two such builds at once, a thread each, beat one after the
 // other on both. Each tree is the one its group's build gives alone (the builders'
-// trees do not depend on the thread count).
+// trees do not depend on the thread count). Each new tree is written into its group's old
+// tree's memory (BuildContext::lend_tree), so a group built again at every commit faults in
+// no fresh pages for it; where a build throws, its group's tree is left empty.
 void rebuild_groups(GroupedBvh& grouped, const std::vector<size_t>& which, const BuilderConfig& config,
                     const PrimitiveSet& prims, BuildInfo* info = nullptr, BuildContext* context = nullptr);
 

@@ -122,6 +122,46 @@ TEST(GroupedBuild, GroupsBuiltAtOnceAreTheirOwnBuildsTrees) {
   }
 }
 
+// A group built again is written into its old tree's memory (BuildContext::lend_tree): a
+// dynamic scene's meshes rebuilt at every commit fault in no fresh pages for their trees.
+// The trees are still each group's own build's, for LBVH, the paper's k-means and the SAH
+// leaves (whose tree of small clusters is kept in the context too), at one and two threads.
+TEST(GroupedBuild, GroupsBuiltAgainTakeTheirOldTreesMemory) {
+  const TriangleScene scene = three_clusters(300.0f);
+  const PrimitiveSet prims = make_primitive_set(scene);
+  const std::vector<uint32_t> first = {0, 300, 700, 1000, 1700, 2000, 2400};
+  for (const char* spec : {"lbvh", "Q1", "Q1GS"}) {
+    const BuilderConfig config = test::config_from_spec(spec);
+    for (const int threads : {1, 2}) {
+      SCOPED_TRACE(std::string(spec) + ", " + std::to_string(threads) + " threads");
+      set_thread_count(threads);
+      BuildContext context;
+      GroupedBvh grouped = build_grouped(config, prims, first, nullptr, &context);
+      std::vector<const BvhNode*> nodes;
+      std::vector<const uint32_t*> indices;
+      for (const Bvh& tree : grouped.trees) {
+        nodes.push_back(tree.nodes.data());
+        indices.push_back(tree.prim_indices.data());
+      }
+      rebuild_groups(grouped, {0, 1, 2, 3, 4, 5, 6}, config, prims, nullptr, &context);
+      set_thread_count(0);
+      for (size_t g = 0; g < first.size(); ++g) {
+        const Bvh alone = run_builder(config, group_primitives(prims, first, g));
+        const Bvh& got = grouped.trees[g];
+        EXPECT_EQ(got.nodes.data(), nodes[g]) << "group " << g;
+        EXPECT_EQ(got.prim_indices.data(), indices[g]) << "group " << g;
+        ASSERT_EQ(got.prim_indices, alone.prim_indices) << "group " << g;
+        ASSERT_EQ(got.nodes.size(), alone.nodes.size()) << "group " << g;
+        for (size_t i = 0; i < got.nodes.size(); ++i) {
+          ASSERT_EQ(got.nodes[i].box, alone.nodes[i].box) << "group " << g << ", node " << i;
+          ASSERT_EQ(got.nodes[i].first, alone.nodes[i].first) << "group " << g << ", node " << i;
+          ASSERT_EQ(got.nodes[i].count, alone.nodes[i].count) << "group " << g << ", node " << i;
+        }
+      }
+    }
+  }
+}
+
 TEST(GroupedBuild, OneGroupIsTheBuildersTree) {
   const TriangleScene scene = three_clusters(300.0f);
   const PrimitiveSet prims = make_primitive_set(scene);

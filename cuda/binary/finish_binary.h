@@ -62,7 +62,7 @@ inline Bvh lay_out(const BinaryTreeView& tree, CollapseView view, const uint32_t
   constexpr uint32_t kAhead = 16;  // queue entries fetched ahead
   Buffer<uint32_t> queue_buffer(2 * n - 1);
   uint32_t* queue = ptr(queue_buffer);
-  Bvh bvh;
+  Bvh bvh = output_tree();
   bvh.nodes.reserve(2 * n - 1);  // at most; node i is appended at step i
   if (range_first) {
     bvh.prim_indices.assign(tree.order, tree.order + n);

@@ -8,7 +8,13 @@ namespace kmbvh {
 
 std::vector<BvhNode> breadth_first_nodes(const BvhNode* in, size_t count, std::vector<uint32_t>& source) {
   std::vector<BvhNode> out;
-  if (count == 0) return out;
+  breadth_first_nodes(in, count, source, out);
+  return out;
+}
+
+void breadth_first_nodes(const BvhNode* in, size_t count, std::vector<uint32_t>& source, std::vector<BvhNode>& out) {
+  out.clear();
+  if (count == 0) return;
   reserve_on_huge_pages(out, count);
   source.clear();  // source[i]: the input index of output node i
   reserve_on_huge_pages(source, count);
@@ -23,7 +29,6 @@ std::vector<BvhNode> breadth_first_nodes(const BvhNode* in, size_t count, std::v
       source.push_back(original.first + c);
     }
   }
-  return out;
 }
 
 Bvh reorder_breadth_first(Bvh in) {

@@ -14,5 +14,7 @@ Bvh reorder_breadth_first(Bvh bvh);
 // nodes[0, count) in breadth-first order, in a new array. `source` is scratch space (the
 // input index of each output node), which a caller building again may keep.
 std::vector<BvhNode> breadth_first_nodes(const BvhNode* nodes, size_t count, std::vector<uint32_t>& source);
+// The same into `out`, whose memory it keeps (emptied first).
+void breadth_first_nodes(const BvhNode* nodes, size_t count, std::vector<uint32_t>& source, std::vector<BvhNode>& out);
 
 }  // namespace kmbvh

@@ -12,6 +12,8 @@
 #include <memory>
 #include <string>
 
+#include "bvh.h"
+
 namespace kmbvh {
 
 class BuildContext {
@@ -40,10 +42,46 @@ class BuildContext {
     for (const auto& [key, w] : workspaces_) bytes += w->bytes_held();
     return bytes;
   }
-  void release() { workspaces_.clear(); }
+  void release() {
+    workspaces_.clear();
+    spare_tree_ = Bvh();
+  }
+
+  // A tree the caller no longer needs (a dynamic scene's mesh, about to be built again),
+  // whose memory the next tree this context's builds return is written into: on this
+  // project's machines a fresh page costs microseconds to fault in, and a mesh of 58k
+  // triangles' tree is about 200 of them. take_spare_tree() gives it emptied, or an empty
+  // tree without memory.
+  void lend_tree(Bvh&& old) { spare_tree_ = std::move(old); }
+  Bvh take_spare_tree() {
+    Bvh tree = std::move(spare_tree_);
+    spare_tree_ = Bvh();
+    tree.nodes.clear();
+    tree.prim_indices.clear();
+    return tree;
+  }
 
  private:
   std::map<std::string, std::unique_ptr<Workspace>> workspaces_;
+  Bvh spare_tree_;
 };
+
+// The context of the build running on this thread, if it has one (UseContext): where a
+// builder's last step takes the memory of the tree it returns (take_spare_tree).
+inline thread_local BuildContext* current_context = nullptr;
+
+class UseContext {
+ public:
+  explicit UseContext(BuildContext* context) : previous_(current_context) { current_context = context; }
+  ~UseContext() { current_context = previous_; }
+  UseContext(const UseContext&) = delete;
+  UseContext& operator=(const UseContext&) = delete;
+
+ private:
+  BuildContext* previous_;
+};
+
+// The tree a build returns, in the memory its context was lent (BuildContext::lend_tree).
+inline Bvh output_tree() { return current_context ? current_context->take_spare_tree() : Bvh(); }
 
 }  // namespace kmbvh

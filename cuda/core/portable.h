@@ -221,6 +221,7 @@ template <typename Build>
 auto in_context(BuildContext* context, const char* key, const Build& build) {
   if (!context) return build();
   const UsePool use(context->workspace<PoolWorkspace>(key).pool);
+  const UseContext current(context);
   return build();
 }
 

@@ -98,7 +98,7 @@ size_t SahLeavesScratch::bytes_held() const {
 }
 
 Bvh collapse_leaves_by_sah(const Bvh& bvh, uint32_t max_leaf_size, const SahLeafCosts& costs,
-                           SahLeavesScratch* scratch) {
+                           SahLeavesScratch* scratch, Bvh memory) {
   if (bvh.empty()) return bvh;
   const size_t n = bvh.nodes.size();
   SahLeavesScratch own;
@@ -124,8 +124,9 @@ Bvh collapse_leaves_by_sah(const Bvh& bvh, uint32_t max_leaf_size, const SahLeaf
   }
   std::sort(opened.begin(), opened.end());
 
-  Bvh out;
-  // Written whole, so populated first (huge_pages.h), not faulted in page by page.
+  Bvh out = std::move(memory);
+  // Written whole, so populated first (huge_pages.h), not faulted in page by page, unless
+  // the memory lent holds it already.
   assign_on_huge_pages(out.nodes, p.nodes[0], BvhNode{});
   assign_on_huge_pages(out.prim_indices, p.count[0], 0u);
   std::vector<Task> tasks;

@@ -35,8 +35,9 @@ struct SahLeavesScratch {
 // primitives, made one leaf; the leaves of `bvh` are kept whole whatever their size. The
 // nodes come out depth first, each leaf's primitives in the order of the leaves it gathers.
 // Its SAH cost (with these constants) is never above the cost of `bvh`.
-// The subtrees below the top of a large tree are written in parallel (OpenMP).
+// The subtrees below the top of a large tree are written in parallel (OpenMP). `memory`: a
+// tree no longer needed, whose arrays the result is written into (BuildContext::lend_tree).
 Bvh collapse_leaves_by_sah(const Bvh& bvh, uint32_t max_leaf_size, const SahLeafCosts& costs = {},
-                           SahLeavesScratch* scratch = nullptr);
+                           SahLeavesScratch* scratch = nullptr, Bvh memory = {});
 
 }  // namespace kmbvh

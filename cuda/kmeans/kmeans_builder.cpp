@@ -13,7 +13,11 @@ namespace {
 // The SAH leaves' per-node arrays, kept in the build context from one build to the next.
 struct SahLeavesWorkspace : BuildContext::Workspace {
   SahLeavesScratch scratch;
-  size_t bytes_held() const override { return scratch.bytes_held(); }
+  Bvh clustered;  // the last build's tree of small clusters, kept for its memory
+  size_t bytes_held() const override {
+    return scratch.bytes_held() + clustered.nodes.capacity() * sizeof(BvhNode) +
+           clustered.prim_indices.capacity() * sizeof(uint32_t);
+  }
 };
 
 Bvh build_on(Backend backend, const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info,
@@ -51,10 +55,15 @@ Bvh build_kmeans(const PrimitiveSet& prims, const KMeansParams& params, Backend 
   KMeansParams fine = params;
   fine.max_leaf_size = std::min(params.max_leaf_size, KMeansParams::kSahLeafCluster);
   fine.breadth_first = false;
-  const Bvh clustered = build_on(backend, prims, fine, info, context);
+  // In a context both trees are written into memory written before: the clusters' into
+  // the last build's, kept in the workspace, the result into the tree the caller lent, if any.
+  SahLeavesWorkspace* ws = context ? &context->workspace<SahLeavesWorkspace>("sah_leaves") : nullptr;
+  Bvh lent = context ? context->take_spare_tree() : Bvh();
+  if (ws) context->lend_tree(std::move(ws->clustered));
+  Bvh clustered = build_on(backend, prims, fine, info, context);
   const auto start = std::chrono::steady_clock::now();
-  SahLeavesScratch* scratch = context ? &context->workspace<SahLeavesWorkspace>("sah_leaves").scratch : nullptr;
-  Bvh bvh = collapse_leaves_by_sah(clustered, params.max_leaf_size, {}, scratch);
+  Bvh bvh = collapse_leaves_by_sah(clustered, params.max_leaf_size, {}, ws ? &ws->scratch : nullptr, std::move(lent));
+  if (ws) ws->clustered = std::move(clustered);
   if (info)
     info->add_phase("sah leaves",
                     std::chrono::duration<double, std::milli>(std::chrono::steady_clock::now() - start).count());

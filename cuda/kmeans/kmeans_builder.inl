@@ -390,7 +390,7 @@ class KMeansLevels {
 #endif
     // Breadth first, the nodes are gathered in the workspace and reordered into the tree;
     // as built, they are gathered into the tree itself.
-    Bvh bvh;
+    Bvh bvh = output_tree();
     std::vector<BvhNode>& built = params_.breadth_first ? ws_.built_nodes : bvh.nodes;
     grow_on_huge_pages(built, total);  // the workspace's is kept at its largest: no zero fill when it fits
     copy_to_host(ptr(nodes_), node_count_, built.data());
@@ -398,10 +398,11 @@ class KMeansLevels {
 #if KMBVH_CPU_SUBTREES
     append_subtrees(built.data(), offset);
 #endif
-    bvh.prim_indices = to_host(final_ids_, n_);
+    bvh.prim_indices.resize(n_);  // in the lent tree's memory, where there is one (output_tree)
+    copy_to_host(ptr(final_ids_), n_, bvh.prim_indices.data());
     if (!keep_) release(final_ids_);
     if (info_) info_->forced_splits += read(forced_, 0);
-    if (params_.breadth_first) bvh.nodes = breadth_first_nodes(built.data(), total, ws_.order_scratch);
+    if (params_.breadth_first) breadth_first_nodes(built.data(), total, ws_.order_scratch, bvh.nodes);
     clock_.lap("finish");
     return bvh;
   }
@@ -465,6 +466,7 @@ inline Bvh build(const PrimitiveSet& prims, const KMeansParams& params, BuildInf
   KMeansWorkspace own;
   KMeansWorkspace& ws = context ? context->workspace<KMeansWorkspace>(key) : own;
   const UsePool pool(ws.scratch);
+  const UseContext current(context);
   if (params.metric == ClusterMetric::Means)
     return build_with_metric<ClusterMetric::Means>(prims, params, info, ws, context != nullptr);
   return build_with_metric<ClusterMetric::Medians>(prims, params, info, ws, context != nullptr);
