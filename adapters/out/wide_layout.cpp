@@ -116,7 +116,7 @@ struct SetIds {
 // make_primitive_set makes where no triangle is dropped, the scene path's and the tools'.
 // One parallel pass over the ids (8 bytes a triangle), where the fill would read each at a
 // random place (conference@4, 1.3M triangles, LBVH's tree, 2 threads, AVX2: the layout
-// made again in its memory 43-46 -> 38-41 ms).
+// made again in its memory 40.4-42.1 -> 38.7-39.4 ms, alternated runs).
 bool ids_in_scene_order(const PrimitiveSet& prims, const TriangleScene& scene) {
   if (prims.size() != scene.triangles.size()) return false;
   const PrimitiveId* ids = prims.ids.data();
@@ -128,10 +128,11 @@ bool ids_in_scene_order(const PrimitiveSet& prims, const TriangleScene& scene) {
 }
 
 // Each triangle a leaf gathers is a chain of dependent reads at random places (its
-// primitive's id, unless the ids are in order, the triangle's vertex indices and reported
-// id, the three positions), a cache miss each: the leaves a few ahead are fetched in stages, each stage
-// reading what the one before fetched, so that the misses of many triangles overlap
-// (conference, Q1's tree, 2 threads: the fill from 7.3 to 5.6 ms once its pages are touched).
+// primitive's id, unless the ids are in order; the triangle's vertex indices and reported
+// id; the three positions), a cache miss each: the leaves a few ahead are fetched in
+// stages, each stage reading what the one before fetched, so that the misses of many
+// triangles overlap (conference, Q1's tree, 2 threads: the fill from 7.3 to 5.6 ms once
+// its pages are touched).
 struct GatherAhead {
   const Bvh& bvh;
   SetIds set_ids;
