@@ -146,7 +146,7 @@ TEST(EmbreeGeometry, FlattensInChunksAsOneSequentialPassWould) {
   };
   std::vector<float> va, vb;
   std::vector<uint32_t> ta, tb;
-  grid(150, 0.0f, va, ta);  // 45,000 triangles: three chunks and a part
+  grid(150, 0.0f, va, ta);  // 45,000 triangles: two chunks and a part
   grid(100, 1.0f, vb, tb);  // 20,000: a chunk and a part
   va[3 * 700 + 1] = std::numeric_limits<float>::quiet_NaN();  // drops triangles in the first chunk
   ta[3 * 40000 + 2] = 1u << 30;                                // and one in the third
