@@ -13,7 +13,7 @@
 
 #include "adapters/builder_registry.h"
 #include "cuda/binary/radix_tree.h"
-#include "cuda/ploc/ploc_steps.h"
+#include "cuda/ploc/find_nearest_cpu.h"
 #include "cuda/core/radix_sort_cpu.h"
 #include "cuda/core/threads.h"
 #include "cuda/metrics/tree_stats.h"
@@ -114,22 +114,55 @@ TEST(Ploc, StaysLogarithmicOnEqualAndNestedBoxes) {
   }
 }
 
-// The CPU's blocked nearest-neighbour search must pick what the GPU's per-cluster search
-// picks, ties included.
+// The CPU's blocked nearest-neighbour search (a running minimum over the pairs) must pick
+// what the GPU's per-cluster search picks, ties included: scenes, a grid of equal boxes
+// (every area tied), boxes whose merged areas overflow to infinity or NaN, and counts that end
+// inside a block and inside the first window.
+std::vector<Aabb> grid_boxes(uint32_t n) {
+  std::vector<Aabb> boxes;
+  for (uint32_t i = 0; i < n; ++i) {
+    const Vec3 at(float(i % 7), float(i / 7 % 5), float(i / 35));
+    boxes.push_back(Aabb(at, at + Vec3(0.5f, 0.5f, 0.5f)));
+  }
+  return boxes;
+}
+std::vector<Aabb> overflowing_boxes(uint32_t n) {
+  // Every other box far out on x and flat in y: two of them merge to a box flat in y and
+  // often infinitely wide, a NaN area; a far one and a near one to an area that overflows
+  // to infinity or not; two near ones to a small area.
+  std::vector<Aabb> boxes;
+  std::mt19937 random(70);
+  std::uniform_real_distribution<float> far(1e38f, 3e38f), near(0.0f, 0.5f);  // far's sign drawn apart
+  for (uint32_t i = 0; i < n; ++i) {
+    const bool far_away = i % 2 == 0;
+    const float x = far_away ? (random() % 2 ? far(random) : -far(random)) : 0.0f;
+    const Vec3 at = far_away ? Vec3(x, 0.0f, 0.0f) : Vec3(near(random), near(random), near(random));
+    boxes.push_back(Aabb(at, at + Vec3(0.01f, far_away ? 0.0f : 0.01f, 0.01f)));
+  }
+  return boxes;
+}
+
 TEST(Ploc, BlockedSearchPicksTheSameNeighbours) {
-  for (const TriangleScene& scene : {test::clustered_triangles(3000, 72), test::identical_triangles(3000)}) {
-    const PrimitiveSet prims = make_primitive_set(scene);
-    const auto n = uint32_t(prims.size());
+  std::vector<std::pair<std::string, std::vector<Aabb>>> inputs;
+  for (const TriangleScene& scene : {test::clustered_triangles(3000, 72), test::identical_triangles(3000)})
+    inputs.emplace_back(scene.name, make_primitive_set(scene).boxes);
+  inputs.emplace_back("grid", grid_boxes(3000));
+  inputs.emplace_back("overflowing", overflowing_boxes(3000));
+  for (uint32_t n : {2u, 3u, 17u, 63u, 65u, 100u})
+    inputs.emplace_back("clustered, " + std::to_string(n), std::vector<Aabb>(inputs[0].second.begin(),
+                                                                             inputs[0].second.begin() + n));
+  for (const auto& [name, boxes] : inputs) {
+    const auto n = uint32_t(boxes.size());
     std::vector<float> columns(6 * size_t(n));
     const BoxColumns box{columns.data(), n};
-    for (uint32_t i = 0; i < n; ++i) box.set(i, prims.boxes[i]);
-    for (uint32_t radius : {1u, 5u, 16u, 32u}) {
+    for (uint32_t i = 0; i < n; ++i) box.set(i, boxes[i]);
+    for (uint32_t radius : {1u, 3u, 5u, 16u, 31u, 32u}) {
       std::vector<uint32_t> per_cluster(n), blocked(n);
       const FindNearest<32> one{box, n, radius, per_cluster.data()};
       for (uint32_t i = 0; i < n; ++i) one(i);
       const FindNearestInBlocks<32, 64> blocks{box, n, radius, blocked.data()};
       for (uint32_t b = 0; b * 64 < n; ++b) blocks(b);
-      EXPECT_EQ(per_cluster, blocked) << scene.name << " radius " << radius;
+      EXPECT_EQ(per_cluster, blocked) << name << " radius " << radius;
     }
   }
 }

@@ -11,6 +11,9 @@
 #include "../core/primitive_set.h"
 #include "../morton/morton_order.h"
 #include "ploc_steps.h"
+#if KMBVH_BACKEND_CPU
+#include "find_nearest_cpu.h"
+#endif
 
 namespace kmbvh {
 namespace KMBVH_BACKEND_NAMESPACE {
@@ -22,7 +25,8 @@ struct CopyToColumns {
 };
 
 // The nearest-neighbour search, sized by the radius (its window is a local array). The CPU
-// works in blocks that compute each pair once, while the radius keeps the block's table small.
+// works in blocks that compute each pair once and hand it to both clusters
+// (find_nearest_cpu.h).
 inline void find_nearest(uint32_t count, uint32_t radius, BoxColumns box, Buffer<uint32_t>& nearest) {
 #if KMBVH_BACKEND_CPU
   constexpr uint32_t kBlock = 256;

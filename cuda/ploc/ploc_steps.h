@@ -6,6 +6,7 @@
 #pragma once
 
 #include <cfloat>
+#include <cstddef>
 #include <cstdint>
 
 #include "../binary/binary_tree.h"
@@ -52,7 +53,9 @@ struct BoxColumns {
   }
 };
 
-KMBVH_HD KMBVH_INLINE float merged_area(const float* c, uint32_t s, uint32_t j, const Aabb& mine) {
+// (Indexed in size_t: with 32-bit indices a window's loads could wrap around, and GCC
+// gathered them one lane at a time instead of loading them as vectors.)
+KMBVH_HD KMBVH_INLINE float merged_area(const float* c, size_t s, size_t j, const Aabb& mine) {
   const float dx = max(c[3 * s + j], mine.hi.x) - min(c[j], mine.lo.x);
   const float dy = max(c[4 * s + j], mine.hi.y) - min(c[s + j], mine.lo.y);
   const float dz = max(c[5 * s + j], mine.hi.z) - min(c[2 * s + j], mine.lo.z);
@@ -99,39 +102,6 @@ struct FindNearest {
     for (uint32_t j = lo; j <= hi; ++j) area[j - lo] = merged_area(box.data, box.stride, j, mine);  // vectorises
     area[i - lo] = FLT_MAX;
     nearest[i] = pick_nearest(i, lo, hi, area);
-  }
-};
-
-// One work item per block of clusters (the CPU's kernel): every pair in or just before the
-// block has its merged area computed once, forwards, into a local table, and each cluster
-// reads its backward neighbours from the table too; the PLOC paper caches distances in
-// shared memory for the same reason. Picks the same neighbours as FindNearest.
-template <uint32_t MaxRadius, uint32_t Block>
-struct FindNearestInBlocks {
-  BoxColumns box;
-  uint32_t count;
-  uint32_t radius;  // at most MaxRadius
-  uint32_t* nearest;
-
-  KMBVH_HD void operator()(uint32_t block) const {
-    const uint32_t a = block * Block, b = a + Block < count ? a + Block : count;
-    const uint32_t first = a > radius ? a - radius : 0;
-    float forward[(Block + MaxRadius) * MaxRadius];  // forward[(i - first) * radius + k]: i with i + 1 + k
-    for (uint32_t i = first; i < b; ++i) {
-      const Aabb mine = box.get(i);
-      float* row = forward + (i - first) * radius;
-      const uint32_t reach = i + radius < count - 1 ? radius : count - 1 - i;
-      for (uint32_t k = 0; k < reach; ++k) row[k] = merged_area(box.data, box.stride, i + 1 + k, mine);
-    }
-    float area[2 * MaxRadius + 1];
-    for (uint32_t i = a; i < b; ++i) {
-      const uint32_t lo = i > radius ? i - radius : 0;
-      const uint32_t hi = i + radius < count - 1 ? i + radius : count - 1;
-      for (uint32_t j = lo; j < i; ++j) area[j - lo] = forward[(j - first) * radius + (i - j - 1)];
-      area[i - lo] = FLT_MAX;
-      for (uint32_t j = i + 1; j <= hi; ++j) area[j - lo] = forward[(i - first) * radius + (j - i - 1)];
-      nearest[i] = pick_nearest(i, lo, hi, area);
-    }
   }
 };
 
