@@ -91,7 +91,7 @@ inline Bvh build_ploc(const PrimitiveSet& prims, const BinaryBuildParams& params
     std::swap(clusters, next_clusters);
     std::swap(cluster_box, next_box);
     next_inner += total.merges;
-    stalled = !stalled && total.merges * kPlocStallFraction < count;
+    stalled = !stalled && ploc_stalled(total.merges, count);
     count = total.kept;
   }
   tree.root = read(clusters, 0);
