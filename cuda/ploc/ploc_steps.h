@@ -109,13 +109,15 @@ struct FindNearest {
 // which few pairs are mutual, and PLOC would need O(n) iterations. After an iteration that
 // merges less than a fraction of the clusters, the next one pairs positions (0,1), (2,3),
 // ... instead, so the number of clusters shrinks geometrically. The fraction is 1/16 while
-// iterations are costly, and 1/64 over the last kPlocTopClusters clusters: there every
-// iteration is cheap, PLOC's own merges come slowly (about 1/20 of the clusters an
-// iteration on the default scene), and clusters paired by position make the top of the tree,
-// where a poor node costs the most (the default scene's SAH cost: 16.9 at 1/16, 4.9 at 1/64).
+// iterations are costly, and 1/64 over the last kPlocTopClusters clusters: there an
+// iteration costs at most a millisecond or so, PLOC's own merges come slowly near the top
+// (1/20 to 1/16 of the clusters an iteration on the default scene and on
+// multiscene_geometry's moved meshes), and clusters paired by position make the top of the
+// tree, where a poor node costs the most (SAH cost: the default scene 16.9 at 1/16, 4.9 at
+// 1/64; multiscene's second commit 16.3 and 9.9).
 constexpr uint32_t kPlocStallFraction = 16;
 constexpr uint32_t kPlocTopStallFraction = 64;
-constexpr uint32_t kPlocTopClusters = 1024;
+constexpr uint32_t kPlocTopClusters = 65536;
 KMBVH_HD KMBVH_INLINE bool ploc_stalled(uint32_t merges, uint32_t count) {
   return merges * (count > kPlocTopClusters ? kPlocStallFraction : kPlocTopStallFraction) < count;
 }
