@@ -115,21 +115,27 @@ const PluginConfig& plugin_config() {
 
 BuilderConfig builder_for(const PluginConfig& config, RTCBuildQuality quality, BuildPath path) {
   // Chosen by measurement (scripts/quality_table.py, the tables in plugin/README.md): LOW and
-  // MEDIUM take the kmbvh configuration nearest to dominating Embree's build of that quality
-  // on the shared scenes (LOW: LBVH, faster and cheaper than every k-means preset there);
-  // HIGH, where Embree's rtcBuildBVH builds MEDIUM's tree in MEDIUM's time, the k-means
-  // configuration with the lowest SAH cost, the faster of equals.
-  const bool lbvh_for_low = quality == RTC_BUILD_QUALITY_LOW && !config.builder_named;
-  if (config.builder != BuilderKind::Kmeans || lbvh_for_low) {
+  // MEDIUM take the kmbvh builder nearest to dominating Embree's build of that quality on
+  // the shared scenes (LOW: LBVH; MEDIUM: PLOC, faster and cheaper than every k-means
+  // configuration there); HIGH, where Embree's rtcBuildBVH builds MEDIUM's tree in MEDIUM's
+  // time, the builder of lowest SAH cost (ATRBVH), the faster of equals. Where k-means is
+  // asked for (KMBVH_BUILDER=kmeans, a preset, K, P or I), the k-means configuration chosen
+  // by the same rules.
+  if (!config.builder_named || config.builder != BuilderKind::Kmeans) {
     BuilderConfig b;
-    b.builder = lbvh_for_low ? BuilderKind::Lbvh : config.builder;
+    b.builder = config.builder_named                  ? config.builder
+                : quality == RTC_BUILD_QUALITY_LOW  ? BuilderKind::Lbvh
+                : quality == RTC_BUILD_QUALITY_HIGH ? BuilderKind::Atrbvh
+                                                    : BuilderKind::Ploc;
     b.backend = config.backend;
     // A scene's layout tests its leaves' triangles kPackWidth at a time, a block for about
     // the price of one triangle: LBVH's leaves, priced a triangle each, would hold about two
     // and leave the blocks half empty (Embree's dynamic_scene: 35% more memory and no faster
     // than with Q1; with a triangle priced at a block's share, 0.33 s against Q1's 0.42:
-    // plugin/README.md).
-    if (lbvh_for_low && path == BuildPath::Scene) b.binary.sah.intersection /= float(kPackWidth);
+    // plugin/README.md). MEDIUM and HIGH keep the SAH's own costs (a path tracer's rays
+    // outnumber its primitives).
+    if (!config.builder_named && quality == RTC_BUILD_QUALITY_LOW && path == BuildPath::Scene)
+      b.binary.sah.intersection /= float(kPackWidth);
     return b;
   }
   std::string preset = config.preset;

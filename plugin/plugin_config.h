@@ -1,7 +1,7 @@
 // What the plug-in builds with, from the environment (read once per process):
 //   KMBVH_BUILDER  kmeans, any kmbvh builder (sweep-sah, lbvh, hlbvh, atrbvh, ploc,
 //                  Q1..Q5), or embree: every call passed to the real Embree; default: by the
-//                  build quality (builder_for: LBVH for LOW, else k-means)
+//                  build quality (builder_for: LBVH for LOW, PLOC for MEDIUM, ATRBVH for HIGH)
 //   KMBVH_PRESET   k-means preset Q1..Q5, QA, or one followed by S; default: chosen by the build quality
 //   KMBVH_K, KMBVH_P, KMBVH_I   k-means parameters, overriding the preset's
 //   KMBVH_LOG=1    one line per build (and per scene) on stderr
@@ -41,7 +41,7 @@ struct PluginConfig {
   BuilderKind builder = BuilderKind::Kmeans;
   std::string preset;         // empty: by build quality
   // KMBVH_BUILDER, KMBVH_PRESET or KMBVH_K/P/I set: that builder (k-means for the last
-  // three) at every build quality, LOW included; otherwise LOW builds with LBVH (builder_for).
+  // three) at every build quality; otherwise the build quality picks it (builder_for).
   bool builder_named = false;
   uint32_t k = 0, p = 0, i = 0;  // 0: the preset's
   Backend backend = Backend::Cpu;
@@ -64,8 +64,8 @@ const PluginConfig& plugin_config();
 enum class BuildPath { BuilderApi, Scene };
 
 // The builder for one build of the given quality: LOW LBVH (a scene's with its leaves
-// priced for the layout's blocks of triangles), MEDIUM k-means Q1GS, HIGH Q2GR, unless the
-// environment names a builder or k-means settings (then LOW's k-means preset is Q1);
+// priced for the layout's blocks of triangles), MEDIUM PLOC, HIGH ATRBVH, unless the
+// environment names a builder, or k-means or its settings (then k-means Q1, Q1GS and Q2GR);
 // plugin/README.md has the tables that chose them.
 BuilderConfig builder_for(const PluginConfig& config, RTCBuildQuality quality, BuildPath path);
 

@@ -5,13 +5,14 @@ Reads the CSV of `kmbvh bench ... --csv FILE` and, for each of Embree's build qu
 (embree-low, embree-medium, embree-high), scores every other builder by how far it is from
 dominating Embree's build on each scene: max(time / Embree's time, SAH / Embree's SAH),
 which is at most 1 where it dominates (no slower, no dearer). The geometric mean over the
-scenes ranks the builders; the best k-means one is the quality's mapping
-(plugin/plugin_config.cpp: builder_for), except where Embree's HIGH builds MEDIUM's tree,
-where HIGH takes the lowest SAH cost. Prints Markdown. Example:
+scenes ranks the builders; the best one is the quality's mapping, and the best k-means one
+the quality's k-means configuration where k-means is asked for (plugin/plugin_config.cpp:
+builder_for), except where Embree's HIGH builds MEDIUM's tree, where HIGH takes the lowest
+SAH cost. Prints Markdown. Example:
 
   build/bin/kmbvh bench default armadillo_libigl bunny_stanford conference fandisk ogre sibenik \\
       sponza_dabrovic spot teapot ww2_cityscene --threads 2 --runs 7 --warmup 1 -q \\
-      --builders lbvh,Q1,Q2,Q3,Q1S,Q2S,Q3S,QA,embree-low,embree-medium,embree-high --csv bench.csv
+      --builders lbvh,ploc,atrbvh,Q1,Q2,Q3,Q1S,Q2S,Q3S,QA,embree-low,embree-medium,embree-high --csv bench.csv
   scripts/quality_table.py bench.csv
 """
 import argparse
@@ -51,21 +52,24 @@ def main():
             scored.append((geomean(miss), builder, geomean(time), geomean(sah), sum(m <= 1.0 for m in miss),
                            max(miss)))
         scored.sort()
-        kmeans = [entry for entry in scored if entry[1].startswith("kmeans ")]
+        ranked = list(scored)
         rule = "nearest to dominating"
         # Where Embree's HIGH builds MEDIUM's tree (rtcBuildBVH: no spatial splits), nearness
         # to dominating it would choose MEDIUM's configuration again; HIGH asks for the best
         # tree, so it takes the lowest SAH cost, the faster of equals (to 1%).
         if quality == "HIGH" and all(abs(rows[s][ref][1] / rows[s]["embree-medium"][1] - 1) < 0.005 for s in scenes):
             rule = "Embree's HIGH builds MEDIUM's tree: lowest SAH"
-            kmeans.sort(key=lambda entry: (round(entry[3], 2), entry[2]))
-        chosen = kmeans[0][1] if kmeans else None
-        print(f"\n**{quality}** against `{ref}` on {len(scenes)} scenes ({rule}); chosen: "
-              f"`{chosen.removeprefix('kmeans ') if chosen else 'none'}`\n")
+            ranked.sort(key=lambda entry: (round(entry[3], 2), entry[2]))
+        kmeans = [entry for entry in ranked if entry[1].startswith("kmeans ")]
+        chosen = ranked[0][1] if ranked else None
+        chosen_kmeans = kmeans[0][1] if kmeans else None
+        shown = lambda builder: f"`{builder.removeprefix('kmeans ')}`" if builder else "none"
+        print(f"\n**{quality}** against `{ref}` on {len(scenes)} scenes ({rule}); chosen: {shown(chosen)}, "
+              f"where k-means is asked for: {shown(chosen_kmeans)}\n")
         print("| builder | from dominating (geomean) | worst scene | time / Embree's | SAH / Embree's | scenes dominated |")
         print("|---|---:|---:|---:|---:|---:|")
         for score, builder, time, sah, dominated, worst in scored:
-            name = f"**{builder}**" if builder == chosen else builder
+            name = f"**{builder}**" if builder in (chosen, chosen_kmeans) else builder
             print(f"| {name} | {score:.2f} | {worst:.2f} | {time:.2f} | {sah:.2f} | {dominated} |")
 
 

@@ -124,13 +124,14 @@ TEST(GroupedBuild, GroupsBuiltAtOnceAreTheirOwnBuildsTrees) {
 
 // A group built again is written into its old tree's memory (BuildContext::lend_tree): a
 // dynamic scene's meshes rebuilt at every commit fault in no fresh pages for their trees.
-// The trees are still each group's own build's, for LBVH, the paper's k-means and the SAH
-// leaves (whose tree of small clusters is kept in the context too), at one and two threads.
+// The trees are still each group's own build's, for LBVH, PLOC and ATRBVH (the scene path's
+// builders at LOW, MEDIUM and HIGH), the paper's k-means and the SAH leaves (whose tree of
+// small clusters is kept in the context too), at one and two threads.
 TEST(GroupedBuild, GroupsBuiltAgainTakeTheirOldTreesMemory) {
   const TriangleScene scene = three_clusters(300.0f);
   const PrimitiveSet prims = make_primitive_set(scene);
   const std::vector<uint32_t> first = {0, 300, 700, 1000, 1700, 2000, 2400};
-  for (const char* spec : {"lbvh", "Q1", "Q1GS"}) {
+  for (const char* spec : {"lbvh", "ploc", "atrbvh", "Q1", "Q1GS"}) {
     const BuilderConfig config = test::config_from_spec(spec);
     for (const int threads : {1, 2}) {
       SCOPED_TRACE(std::string(spec) + ", " + std::to_string(threads) + " threads");
