@@ -14,6 +14,7 @@
 #include "adapters/builder_registry.h"
 #include "cuda/binary/radix_tree.h"
 #include "cuda/ploc/find_nearest_cpu.h"
+#include "cuda/ploc/iteration_cpu.h"
 #include "cuda/ploc/ploc_steps.h"
 #include "cuda/core/radix_sort_cpu.h"
 #include "cuda/core/threads.h"
@@ -172,6 +173,88 @@ TEST(Ploc, BlockedSearchPicksTheSameNeighbours) {
       for (uint32_t b = 0; b * 64 < n; ++b) blocks(b);
       EXPECT_EQ(per_cluster, blocked) << name << " radius " << radius;
     }
+  }
+}
+
+// PLOC's clustering as the GPU runs it, a step at a time (the per-cluster search or the
+// positional pairs, the counts, their exclusive scan, the merge), or as the CPU runs it
+// (ploc_iteration_cpu: one parallel region), from boxes in Morton order to one cluster.
+struct PlocRun {
+  std::vector<uint32_t> left, right, parent, clusters, next_clusters, nearest;
+  std::vector<Aabb> box;
+  std::vector<float> columns, next_columns;
+  uint32_t iterations = 0, paired = 0;
+
+  PlocRun(const std::vector<Aabb>& leaves, bool fused) {
+    const auto n = uint32_t(leaves.size());
+    left.resize(n - 1), right.resize(n - 1), parent.resize(2 * n - 1), box.resize(2 * n - 1);
+    clusters.resize(n), next_clusters.resize(n), nearest.resize(n);
+    columns.resize(6 * size_t(n)), next_columns.resize(6 * size_t(n));
+    BinaryTreeView tree;
+    tree.n = n, tree.left = left.data(), tree.right = right.data(), tree.parent = parent.data();
+    tree.box = box.data();
+    BoxColumns cluster_box{columns.data(), n}, next_box{next_columns.data(), n};
+    for (uint32_t i = 0; i < n; ++i) box[i] = leaves[i], cluster_box.set(i, leaves[i]), clusters[i] = i;
+    uint32_t count = n, next_inner = n;
+    bool stalled = false;
+    // Every third iteration's neighbours are paired by position too (as after a stall).
+    for (; count > 1; ++iterations) {
+      const bool pair = stalled || iterations % 3 == 2;
+      paired += pair;
+      MergeAndCompact merge{clusters.data(), cluster_box, nearest.data(), nullptr, next_inner, tree,
+                            next_clusters.data(), next_box};
+      MergeCounts total;
+      if (fused) {
+        total = ploc_iteration_cpu(count, 16, pair, cluster_box, nearest.data(), merge);
+      } else {
+        for (uint32_t i = 0; i < count; ++i) {
+          if (pair)
+            PairNeighbours{count, nearest.data()}(i);
+          else
+            FindNearest<16>{cluster_box, count, 16, nearest.data()}(i);
+        }
+        std::vector<MergeCounts> counts(count), offsets(count);
+        CountMerges counter{nearest.data(), counts.data()};
+        for (uint32_t i = 0; i < count; ++i) counter(i);
+        for (uint32_t i = 0; i < count; ++i) {
+          offsets[i] = total;
+          total = AddMergeCounts{}(total, counts[i]);
+        }
+        merge.offsets = offsets.data();
+        for (uint32_t i = 0; i < count; ++i) merge(i);
+      }
+      std::swap(clusters, next_clusters);
+      std::swap(cluster_box, next_box);
+      std::swap(columns, next_columns);
+      next_inner += total.merges;
+      stalled = !stalled && ploc_stalled(total.merges, count);
+      count = total.kept;
+    }
+  }
+};
+
+// The CPU's fused iteration leaves what the GPU's steps leave, iteration by iteration up to
+// the root: the same inner nodes, parents and boxes, at one and two threads (shares split
+// inside pairs and between a cluster and its neighbours), searched and paired.
+TEST(Ploc, FusedIterationIsTheStepByStepIteration) {
+  const PrimitiveSet prims = make_primitive_set(test::clustered_triangles(20000, 73));
+  std::vector<Aabb> leaves(prims.boxes.begin(), prims.boxes.end());
+  std::sort(leaves.begin(), leaves.end(), [](const Aabb& a, const Aabb& b) { return a.lo.x < b.lo.x; });
+  const PlocRun steps(leaves, false);
+  EXPECT_GT(steps.paired, 3u);
+  for (const int threads : {1, 2}) {
+    SCOPED_TRACE(std::to_string(threads) + " threads");
+    set_thread_count(threads);
+    const PlocRun fused(leaves, true);
+    set_thread_count(0);
+    EXPECT_EQ(fused.iterations, steps.iterations);
+    EXPECT_EQ(fused.left, steps.left);
+    EXPECT_EQ(fused.right, steps.right);
+    EXPECT_EQ(fused.parent, steps.parent);
+    EXPECT_TRUE(std::equal(fused.box.begin(), fused.box.end(), steps.box.begin(), [](const Aabb& a, const Aabb& b) {
+      return a.lo.x == b.lo.x && a.lo.y == b.lo.y && a.lo.z == b.lo.z && a.hi.x == b.hi.x && a.hi.y == b.hi.y &&
+             a.hi.z == b.hi.z;
+    }));
   }
 }
 

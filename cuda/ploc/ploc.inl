@@ -12,7 +12,7 @@
 #include "../morton/morton_order.h"
 #include "ploc_steps.h"
 #if KMBVH_BACKEND_CPU
-#include "find_nearest_cpu.h"
+#include "iteration_cpu.h"
 #endif
 
 namespace kmbvh {
@@ -24,23 +24,32 @@ struct CopyToColumns {
   KMBVH_HD void operator()(uint32_t i) const { columns.set(i, boxes[i]); }
 };
 
-// The nearest-neighbour search, sized by the radius (its window is a local array). The CPU
-// works in blocks that compute each pair once and hand it to both clusters
-// (find_nearest_cpu.h).
+// The nearest-neighbour search, sized by the radius (its window is a local array).
 inline void find_nearest(uint32_t count, uint32_t radius, BoxColumns box, Buffer<uint32_t>& nearest) {
-#if KMBVH_BACKEND_CPU
-  constexpr uint32_t kBlock = 256;
-  if (radius <= 32) {
-    for_each_index((count + kBlock - 1) / kBlock, FindNearestInBlocks<32, kBlock>{box, count, radius, ptr(nearest)});
-    return;
-  }
-#endif
   if (radius <= 16)
     for_each_index(count, FindNearest<16>{box, count, radius, ptr(nearest)});
   else if (radius <= 64)
     for_each_index(count, FindNearest<64>{box, count, radius, ptr(nearest)});
   else
     for_each_index(count, FindNearest<1024>{box, count, radius, ptr(nearest)});
+}
+
+// One iteration as the GPU runs it, a step a launch: the neighbours, the merges counted and
+// scanned, the survivors compacted. Returns the merges and the clusters left.
+inline MergeCounts ploc_iteration(uint32_t count, uint32_t radius, bool paired, BoxColumns box,
+                                  Buffer<uint32_t>& nearest, Buffer<MergeCounts>& counts,
+                                  Buffer<MergeCounts>& offsets, MergeAndCompact merge) {
+  if (paired)
+    for_each_index(count, PairNeighbours{count, ptr(nearest)});
+  else
+    find_nearest(count, radius, box, nearest);
+  for_each_index(count, CountMerges{ptr(nearest), ptr(counts)});
+  thrust::exclusive_scan(launch(), counts.begin(), counts.begin() + count, offsets.begin(), MergeCounts{},
+                         AddMergeCounts{});
+  const MergeCounts total = AddMergeCounts{}(read(offsets, count - 1), read(counts, count - 1));
+  merge.offsets = ptr(offsets);
+  for_each_index(count, merge);
+  return total;
 }
 
 inline Bvh build_ploc(const PrimitiveSet& prims, const BinaryBuildParams& params, BuildInfo* info) {
@@ -70,24 +79,26 @@ inline Bvh build_ploc(const PrimitiveSet& prims, const BinaryBuildParams& params
   Buffer<float> box_columns[2] = {Buffer<float>(6 * size_t(n)), Buffer<float>(6 * size_t(n))};
   BoxColumns cluster_box{ptr(box_columns[0]), n}, next_box{ptr(box_columns[1]), n};
   for_each_index(n, CopyToColumns{tree.box, cluster_box});
-  Buffer<MergeCounts> counts(n), offsets(n);
+#if KMBVH_BACKEND_CPU
+  // An iteration in one parallel region (iteration_cpu.h), with no counts to scan.
+  const bool fused = params.ploc_radius <= kPlocCpuMaxRadius;
+#else
+  const bool fused = false;
+#endif
+  Buffer<MergeCounts> counts(fused ? 0 : n), offsets(fused ? 0 : n);
   thrust::sequence(launch(), clusters.begin(), clusters.end());  // leaf i: position i
   uint32_t count = n, next_inner = n;
   bool stalled = false;
   while (count > 1) {
     if (info) ++info->levels;
-    if (stalled) {
-      for_each_index(count, PairNeighbours{count, ptr(nearest)});
-      if (info) ++info->forced_splits;
-    } else {
-      find_nearest(count, params.ploc_radius, cluster_box, nearest);
-    }
-    for_each_index(count, CountMerges{ptr(nearest), ptr(counts)});
-    thrust::exclusive_scan(launch(), counts.begin(), counts.begin() + count, offsets.begin(), MergeCounts{},
-                           AddMergeCounts{});
-    const MergeCounts total = AddMergeCounts{}(read(offsets, count - 1), read(counts, count - 1));
-    for_each_index(count, MergeAndCompact{ptr(clusters), cluster_box, ptr(nearest), ptr(offsets), next_inner, tree,
-                                          ptr(next_clusters), next_box});
+    if (stalled && info) ++info->forced_splits;
+    const MergeAndCompact merge{ptr(clusters), cluster_box, ptr(nearest), nullptr, next_inner, tree,
+                                ptr(next_clusters), next_box};
+    MergeCounts total;
+#if KMBVH_BACKEND_CPU
+    if (fused) total = ploc_iteration_cpu(count, params.ploc_radius, stalled, cluster_box, ptr(nearest), merge);
+#endif
+    if (!fused) total = ploc_iteration(count, params.ploc_radius, stalled, cluster_box, nearest, counts, offsets, merge);
     std::swap(clusters, next_clusters);
     std::swap(cluster_box, next_box);
     next_inner += total.merges;

@@ -146,15 +146,19 @@ KMBVH_HD KMBVH_INLINE bool mutual_pair(const uint32_t* nearest, uint32_t i, uint
   return j != i && nearest[j] == i;
 }
 
+// What position i adds: a merge where it is the lower of a mutual pair, a survivor unless
+// it is the higher.
+KMBVH_HD KMBVH_INLINE MergeCounts merge_counts(const uint32_t* nearest, uint32_t i) {
+  const uint32_t j = nearest[i];
+  const bool mutual = mutual_pair(nearest, i, j);
+  return {mutual && i < j ? 1u : 0u, mutual && i > j ? 0u : 1u};
+}
+
 struct CountMerges {
   const uint32_t* nearest;
   MergeCounts* out;
 
-  KMBVH_HD void operator()(uint32_t i) const {
-    const uint32_t j = nearest[i];
-    const bool mutual = mutual_pair(nearest, i, j);
-    out[i] = {mutual && i < j ? 1u : 0u, mutual && i > j ? 0u : 1u};
-  }
+  KMBVH_HD void operator()(uint32_t i) const { out[i] = merge_counts(nearest, i); }
 };
 
 // The lower position of a mutual pair makes the new inner node and keeps it; the higher
@@ -163,13 +167,16 @@ struct MergeAndCompact {
   const uint32_t* clusters;
   BoxColumns cluster_box;
   const uint32_t* nearest;
-  const MergeCounts* offsets;  // exclusive scan of CountMerges
+  const MergeCounts* offsets;  // exclusive scan of CountMerges (operator(); at() is given them)
   uint32_t first_inner;        // node id of this iteration's first new inner node
   BinaryTreeView tree;
   uint32_t* next_clusters;
   BoxColumns next_box;
 
-  KMBVH_HD void operator()(uint32_t i) const {
+  KMBVH_HD void operator()(uint32_t i) const { at(i, offsets[i]); }
+
+  // Position i, with `before` the merges and survivors of the positions before it.
+  KMBVH_HD void at(uint32_t i, MergeCounts before) const {
     const uint32_t j = nearest[i];
     const bool mutual = mutual_pair(nearest, i, j);
     if (mutual && i > j) return;
@@ -177,7 +184,7 @@ struct MergeAndCompact {
     Aabb box = cluster_box.get(i);
     if (mutual) {
       const uint32_t a = clusters[i], b = clusters[j];
-      node = first_inner + offsets[i].merges;
+      node = first_inner + before.merges;
       box = join(box, cluster_box.get(j));
       tree.left[tree.inner(node)] = a;
       tree.right[tree.inner(node)] = b;
@@ -185,8 +192,8 @@ struct MergeAndCompact {
       tree.parent[b] = node;
       tree.box[node] = box;
     }
-    next_clusters[offsets[i].kept] = node;
-    next_box.set(offsets[i].kept, box);
+    next_clusters[before.kept] = node;
+    next_box.set(before.kept, box);
   }
 };
 
