@@ -98,7 +98,8 @@ inline Bvh build_ploc(const PrimitiveSet& prims, const BinaryBuildParams& params
 #if KMBVH_BACKEND_CPU
     if (fused) total = ploc_iteration_cpu(count, params.ploc_radius, stalled, cluster_box, ptr(nearest), merge);
 #endif
-    if (!fused) total = ploc_iteration(count, params.ploc_radius, stalled, cluster_box, nearest, counts, offsets, merge);
+    if (!fused)
+      total = ploc_iteration(count, params.ploc_radius, stalled, cluster_box, nearest, counts, offsets, merge);
     std::swap(clusters, next_clusters);
     std::swap(cluster_box, next_box);
     next_inner += total.merges;
