@@ -125,8 +125,8 @@ TEST(Ploc, StaysLogarithmicOnEqualAndNestedBoxes) {
 
 // The CPU's blocked nearest-neighbour search (a running minimum over the pairs) must pick
 // what the GPU's per-cluster search picks, ties included: scenes, a grid of equal boxes
-// (every area tied), boxes whose merged areas overflow to infinity or NaN, and counts that end
-// inside a block and inside the first window.
+// (every area tied), boxes whose merged areas overflow to infinity or NaN (a whole row of
+// them too), and counts that end inside a block and inside the first window.
 std::vector<Aabb> grid_boxes(uint32_t n) {
   std::vector<Aabb> boxes;
   for (uint32_t i = 0; i < n; ++i) {
@@ -151,12 +151,24 @@ std::vector<Aabb> overflowing_boxes(uint32_t n) {
   return boxes;
 }
 
+// A box whose merged areas with all of the next ones are NaN (it far out on +x, they on -x,
+// all flat in y), and nothing before it.
+std::vector<Aabb> nan_row_boxes(uint32_t n) {
+  std::vector<Aabb> boxes;
+  for (uint32_t i = 0; i < n; ++i) {
+    const Vec3 at(i == 0 ? 3e38f : -3e38f + float(i) * 1e32f, 0.0f, float(i));
+    boxes.push_back(Aabb(at, at + Vec3(0.0f, 0.0f, 0.5f)));
+  }
+  return boxes;
+}
+
 TEST(Ploc, BlockedSearchPicksTheSameNeighbours) {
   std::vector<std::pair<std::string, std::vector<Aabb>>> inputs;
   for (const TriangleScene& scene : {test::clustered_triangles(3000, 72), test::identical_triangles(3000)})
     inputs.emplace_back(scene.name, make_primitive_set(scene).boxes);
   inputs.emplace_back("grid", grid_boxes(3000));
   inputs.emplace_back("overflowing", overflowing_boxes(3000));
+  inputs.emplace_back("NaN row", nan_row_boxes(100));
   for (uint32_t n : {2u, 3u, 17u, 63u, 65u, 100u})
     inputs.emplace_back("clustered, " + std::to_string(n), std::vector<Aabb>(inputs[0].second.begin(),
                                                                              inputs[0].second.begin() + n));

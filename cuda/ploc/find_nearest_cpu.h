@@ -71,7 +71,7 @@ struct FindNearestInBlocks {
         const float upper = low[2] < low[3] ? low[2] : low[3];
         smallest = upper < smallest ? upper : smallest;
         const uint32_t at = i - first;
-        if (smallest <= best[at]) {
+        if (smallest <= best[at] && smallest < inf) {  // (a row all NaN has no lane to find)
           // Of forward candidates at the smallest area the first lane is the nearest.
           const V s = {smallest, smallest, smallest, smallest};
           uint32_t v = 0;
