@@ -190,7 +190,7 @@ TEST(Ploc, BlockedSearchPicksTheSameNeighbours) {
 
 // PLOC's clustering as the GPU runs it, a step at a time (the per-cluster search or the
 // positional pairs, the counts, their exclusive scan, the merge), or as the CPU runs it
-// (ploc_iteration_cpu: one parallel region), from boxes in Morton order to one cluster.
+// (ploc_iteration_cpu: one parallel region), from the leaves' boxes in their order to one cluster.
 struct PlocRun {
   std::vector<uint32_t> left, right, parent, clusters, next_clusters, nearest;
   std::vector<Aabb> box;
@@ -237,7 +237,6 @@ struct PlocRun {
       }
       std::swap(clusters, next_clusters);
       std::swap(cluster_box, next_box);
-      std::swap(columns, next_columns);
       next_inner += total.merges;
       stalled = !stalled && ploc_stalled(total.merges, count);
       count = total.kept;
