@@ -102,13 +102,7 @@ struct FindNearestInBlocks {
         continue;
       }
       // Areas that overflow (FindNearest keeps such a cluster to itself) or are all NaN.
-      const uint32_t lo = i > radius ? i - radius : 0;
-      const uint32_t hi = i + radius < count - 1 ? i + radius : count - 1;
-      const Aabb mine = box.get(i);
-      float area[2 * MaxRadius + 1];
-      for (uint32_t j = lo; j <= hi; ++j) area[j - lo] = merged_area(box.data, box.stride, j, mine);
-      area[i - lo] = FLT_MAX;
-      nearest[i] = pick_nearest(i, lo, hi, area);
+      FindNearest<MaxRadius>{box, count, radius, nearest}(i);
     }
   }
 };
