@@ -12,6 +12,7 @@
 #include "adapters/embree/embree_geometry.h"
 #include "adapters/out/tracer.h"
 #include "cuda/core/threads.h"
+#include "cuda/traversal/watertight.h"
 #include "support/scenes.h"
 
 namespace kmbvh {
@@ -279,6 +280,45 @@ TEST(TraceOne, SameAsTheBatchTraversalWithAndWithoutAFilter) {
     }
     EXPECT_GT(hits, rays.size() / 4);
   }
+}
+
+
+// An occlusion query's filter is offered each candidate with the float watertight test's t,
+// u, v and Ng, as Embree offers its own (trace_wide_kernel.inl: float_hit): u, v and Ng bit
+// for bit what the scalar test gives for that triangle, t within its rounding (the pack
+// test divides where the scalar test multiplies by the reciprocal); and a refused candidate
+// lets the query go on.
+TEST(TraceOne, OcclusionFiltersAreOfferedTheFloatTestsHit) {
+  const TriangleScene scene = test::random_triangles(3000, 7);
+  const PrimitiveSet prims = make_primitive_set(scene);
+  const Tracer tracer(run_builder(parse_builder("ploc"), prims), prims, scene, Layout::Bvh8);
+  const std::vector<Ray> rays = random_rays(scene, 2000);
+  struct Offers {
+    const TriangleScene* scene;
+    size_t offered = 0, same = 0;
+  } offers{&scene};
+  const HitFilter check_and_refuse{[](void* user, const Ray& ray, const Hit& h) {
+                                     Offers& o = *static_cast<Offers*>(user);
+                                     const Triangle& t = o.scene->triangles[h.primID];
+                                     const Vec3 a = o.scene->positions[t[0]], b = o.scene->positions[t[1]],
+                                                c = o.scene->positions[t[2]];
+                                     Hit f;
+                                     const bool hit = intersect_watertight(RayShear(ray), ray.tnear,
+                                                                           std::numeric_limits<float>::infinity(), a,
+                                                                           b, c, f);
+                                     ++o.offered;
+                                     // t is the pack test's T / det, the scalar test's T * (1 / det)
+                                     o.same += hit && std::fabs(f.t - h.t) <= 2e-7f * f.t && f.u == h.u &&
+                                               f.v == h.v && f.Ng.x == h.Ng.x && f.Ng.y == h.Ng.y && f.Ng.z == h.Ng.z;
+                                     return false;
+                                   },
+                                   &offers};
+  for (const Ray& ray : rays) {
+    Hit refused;
+    EXPECT_FALSE(tracer.trace_one(ray, Query::Any, refused, check_and_refuse));
+  }
+  EXPECT_GT(offers.offered, rays.size() / 2);
+  EXPECT_EQ(offers.same, offers.offered);
 }
 
 }  // namespace

@@ -26,6 +26,16 @@ TraversalCounters& TraversalCounters::operator+=(const TraversalCounters& o) {
   return *this;
 }
 
+namespace {
+// A stack for trees deeper than trace_wide_ray's stack on the C++ stack holds: one per
+// thread, kept (no tree seen in practice needs it).
+WideEntry* deep_stack(uint32_t size) {
+  thread_local std::vector<WideEntry> stack;
+  if (stack.size() < size) stack.resize(size);
+  return stack.data();
+}
+}  // namespace
+
 // The kernel once per instruction set (trace_wide_kernel.inl). This file is compiled for
 // x86-64-v2 (adapters/CMakeLists.txt), and so is the SSE4.2 variant; the AVX2 and AVX-512
 // variants are compiled in target regions that add their features (the same lists as
@@ -77,7 +87,7 @@ namespace {
 template <int W>
 struct Kernels {
   void (*trace_rays)(const WideBvh<W>&, const Ray*, size_t, Query, Hit*, WideEntry*, TraversalCounters*);
-  bool (*trace_one)(const WideBvh<W>&, const Ray&, Query, WideEntry*, Hit&, const HitFilter*);
+  bool (*trace_one)(const WideBvh<W>&, const Ray&, Query, Hit&, const HitFilter*);
   void (*trace_packet)(const WideBvh<W>&, const Ray*, unsigned, Query, Hit*, TraversalCounters*);
   void (*trace_packets)(const WideBvh<W>&, const Ray*, size_t, Query, Hit*, TraversalCounters*);
 };
@@ -102,14 +112,8 @@ const Kernels<W>& chosen_kernels() {
 }  // namespace
 
 template <int W>
-bool trace_wide_ray(const WideBvh<W>& bvh, const Ray& ray, Query query, WideEntry* stack, Hit& hit) {
-  return chosen_kernels<W>().trace_one(bvh, ray, query, stack, hit, nullptr);
-}
-
-template <int W>
-bool trace_wide_ray(const WideBvh<W>& bvh, const Ray& ray, Query query, WideEntry* stack, Hit& hit,
-                    const HitFilter& filter) {
-  return chosen_kernels<W>().trace_one(bvh, ray, query, stack, hit, &filter);
+bool trace_wide_ray(const WideBvh<W>& bvh, const Ray& ray, Query query, Hit& hit, const HitFilter* filter) {
+  return chosen_kernels<W>().trace_one(bvh, ray, query, hit, filter);
 }
 
 template <int W>
@@ -177,10 +181,8 @@ void trace_wide_packet(const WideBvh<W>& bvh, const Ray* rays, unsigned valid, Q
   chosen_kernels<W>().trace_packet(bvh, rays, valid, query, hits, nullptr);
 }
 
-template bool trace_wide_ray<4>(const WideBvh<4>&, const Ray&, Query, WideEntry*, Hit&);
-template bool trace_wide_ray<8>(const WideBvh<8>&, const Ray&, Query, WideEntry*, Hit&);
-template bool trace_wide_ray<4>(const WideBvh<4>&, const Ray&, Query, WideEntry*, Hit&, const HitFilter&);
-template bool trace_wide_ray<8>(const WideBvh<8>&, const Ray&, Query, WideEntry*, Hit&, const HitFilter&);
+template bool trace_wide_ray<4>(const WideBvh<4>&, const Ray&, Query, Hit&, const HitFilter*);
+template bool trace_wide_ray<8>(const WideBvh<8>&, const Ray&, Query, Hit&, const HitFilter*);
 template void trace_wide<4>(const WideBvh<4>&, const std::vector<Ray>&, Query, std::vector<Hit>&);
 template void trace_wide<8>(const WideBvh<8>&, const std::vector<Ray>&, Query, std::vector<Hit>&);
 template void trace_wide<4>(const WideBvh<4>&, const Ray*, size_t, Query, Hit*, TraversalCounters*);

@@ -60,12 +60,6 @@ struct WideEntry {
   float entry;          // where the ray enters its box: skipped once a closer hit is known
 };
 
-// One ray; `stack` holds bvh.stack_size entries. For Query::Any the hit names the
-// occluding triangle and its t from the float test, unrefined (Embree's occlusion queries
-// report only that something is hit); Query::Closest refines it in double precision.
-template <int W>
-bool trace_wide_ray(const WideBvh<W>& bvh, const Ray& ray, Query query, WideEntry* stack, Hit& hit);
-
 // Decides whether a candidate hit counts (Embree's filter functions): `offered` is complete
 // (t, u, v, Ng, ids); returning false skips it and the traversal goes on.
 struct HitFilter {
@@ -73,11 +67,14 @@ struct HitFilter {
   void* user;
 };
 
-// The same with every candidate hit offered to `filter` first, in traversal order: for
+// One ray on the calling thread (rtcIntersect1), its stack on the C++ stack (a tree deeper
+// than any seen in practice gets a thread-local one). For Query::Any the hit names the
+// occluding triangle and its t from the float test, unrefined (Embree's occlusion queries
+// report only that something is hit); Query::Closest refines it in double precision.
+// With `filter`, every candidate hit is offered to it first, in traversal order: for
 // Query::Any the first accepted hit ends the ray; for Query::Closest accepted hits shorten
 // the ray as they come, as in Embree.
 template <int W>
-bool trace_wide_ray(const WideBvh<W>& bvh, const Ray& ray, Query query, WideEntry* stack, Hit& hit,
-                    const HitFilter& filter);
+bool trace_wide_ray(const WideBvh<W>& bvh, const Ray& ray, Query query, Hit& hit, const HitFilter* filter = nullptr);
 
 }  // namespace kmbvh

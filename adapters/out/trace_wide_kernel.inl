@@ -221,10 +221,11 @@ inline Vec3 slot_vertex(const TrianglePack& p, int v, uint32_t slot) {
 // How a pack's candidate hits are confirmed in double precision (watertight.h), which
 // keeps a needle's float t from landing on the wrong side of tnear or tmax:
 // - Exact: each by exact_check before it counts, which also gives the t, u and v the hit
-//   reports (a filter is offered complete hits), and by the double-precision test where
-//   the exact barycentrics put the ray outside the triangle (a needle);
+//   reports (a closest-hit filter is offered complete hits), and by the double-precision
+//   test where the exact barycentrics put the ray outside the triangle (a needle);
 // - Interval: each by exact_within, the interval and that test (occlusion reports no t, u
-//   or v), unless the float test's hit is certain (certain_hit);
+//   or v, and its filters are offered the float test's: float_hit), unless the float
+//   test's hit is certain (certain_hit);
 // - Deferred: none while the ray runs; the closest hit's, once found, by exact_check over
 //   the interval it was accepted in (traverse), and in the rare case it fails there the ray
 //   is traced again with Exact. A closest-hit ray meets 1.1-1.3 candidates on average, so
@@ -478,6 +479,27 @@ __attribute__((always_inline)) inline bool finish_hit(const WideBvh<W>& bvh, uin
   return true;
 }
 
+// An occlusion candidate as a filter is offered it (hit.t is set): its ids, and the float
+// test's u, v and Ng, as Embree offers its own. The candidate is decided as an unfiltered
+// occlusion query decides it (Confirm::Interval); the exact t, u and v a closest hit reports
+// would cost a double-precision check per candidate. u and v are the scalar test's (its
+// edge functions are the pack test's, times 1 / det); t stays the candidate's own, the pack
+// test's T / det.
+template <int W>
+__attribute__((always_inline)) inline void float_hit(const WideBvh<W>& bvh, uint32_t found, const PackRay& r,
+                                                     Hit& hit) {
+  const TrianglePack& p = bvh.packs[found / kPackWidth];
+  const uint32_t slot = found % kPackWidth;
+  hit.geomID = p.id[slot].geom;
+  hit.primID = p.id[slot].prim;
+  const Vec3 a = slot_vertex(p, 0, slot), b = slot_vertex(p, 1, slot), c = slot_vertex(p, 2, slot);
+  Hit h;
+  if (intersect_watertight(r.shear, r.ray.tnear, std::numeric_limits<float>::infinity(), a, b, c, h)) {
+    hit.u = h.u, hit.v = h.v;
+  }
+  hit.Ng = cross(b - a, c - a);
+}
+
 // A ray's end: its counts, when counted, go to `counted`.
 inline bool finish(NoTally, TraversalCounters*, bool found) { return found; }
 inline bool finish(const Tally& t, TraversalCounters* counted, bool found) {
@@ -501,7 +523,7 @@ inline bool finish(const Tally& t, TraversalCounters* counted, bool found) {
 // before it that the deferred run would not have taken instead of c; so both end on c. If
 // c fails, the ray is traced again with Exact.
 template <int W, Query query, bool Filtered = false, typename Count = NoTally,
-          Confirm confirm = Filtered ? Confirm::Exact : query == Query::Any ? Confirm::Interval : Confirm::Deferred>
+          Confirm confirm = query == Query::Any ? Confirm::Interval : Filtered ? Confirm::Exact : Confirm::Deferred>
 bool traverse(const WideBvh<W>& bvh, const Ray& ray, WideEntry* stack, Hit& hit, const HitFilter* filter = nullptr,
               Count count = {}, TraversalCounters* counted = nullptr);
 
@@ -602,7 +624,11 @@ __attribute__((always_inline)) inline bool descend(const WideBvh<W>& bvh, const 
         const uint32_t candidate = p * kPackWidth + uint32_t(slot);
         Hit offered;
         offered.t = c.t;
-        finish_hit(bvh, candidate, c.check, offered);
+        if constexpr (confirm == Confirm::Exact) {
+          finish_hit(bvh, candidate, c.check, offered);
+        } else {
+          float_hit(bvh, candidate, pack_ray, offered);
+        }
         if (!filter->accept(filter->user, ray, offered)) {
           skip |= 1u << slot;
           continue;
@@ -755,10 +781,15 @@ void trace_rays(const WideBvh<W>& bvh, const Ray* rays, size_t n, Query query, H
   }
 }
 
+// The traversal stack of trace_one: on the C++ stack up to this many entries (6 KiB),
+// which covers 8-wide trees 73 levels deep; a deeper tree gets a thread-local buffer.
+constexpr uint32_t kLocalStack = 512;
+
 // One ray, with every candidate hit offered to `filter` when it is not null.
 template <int W>
-bool trace_one(const WideBvh<W>& bvh, const Ray& ray, Query query, WideEntry* stack, Hit& hit,
-               const HitFilter* filter) {
+bool trace_one(const WideBvh<W>& bvh, const Ray& ray, Query query, Hit& hit, const HitFilter* filter) {
+  WideEntry local[kLocalStack];
+  WideEntry* stack = bvh.stack_size <= kLocalStack ? local : deep_stack(bvh.stack_size);
   if (filter) {
     return query == Query::Any ? traverse<W, Query::Any, true>(bvh, ray, stack, hit, filter)
                                : traverse<W, Query::Closest, true>(bvh, ray, stack, hit, filter);

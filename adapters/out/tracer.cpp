@@ -96,22 +96,14 @@ std::optional<TraversalCounters> Tracer::count(const std::vector<Ray>& rays, Que
 
 namespace {
 
-// The traversal stack of trace_one: on the C++ stack up to this many entries (6 KiB),
-// which covers 8-wide trees 73 levels deep; a deeper tree gets a thread-local buffer.
+// The portable BVH2 kernel's stack in trace_one: on the C++ stack up to this many entries
+// (6 KiB); a deeper tree gets a thread-local buffer.
 constexpr uint32_t kLocalStack = 512;
 
-template <typename Entry>
-Entry* deep_stack(uint32_t size) {
-  thread_local std::vector<Entry> stack;
+TraversalEntry* deep_bvh2_stack(uint32_t size) {
+  thread_local std::vector<TraversalEntry> stack;
   if (stack.size() < size) stack.resize(size);
   return stack.data();
-}
-
-template <int W>
-bool trace_one_wide(const WideBvh<W>& bvh, const Ray& ray, Query query, Hit& hit, const HitFilter* filter) {
-  WideEntry local[kLocalStack];
-  WideEntry* stack = bvh.stack_size <= kLocalStack ? local : deep_stack<WideEntry>(bvh.stack_size);
-  return filter ? trace_wide_ray(bvh, ray, query, stack, hit, *filter) : trace_wide_ray(bvh, ray, query, stack, hit);
 }
 
 }  // namespace
@@ -121,11 +113,11 @@ bool Tracer::trace_one(const Ray& ray, Query query, Hit& hit) const {
     case Layout::Bvh2: {
       const Bvh2& b = layouts_->bvh2;
       TraversalEntry local[kLocalStack];
-      TraversalEntry* stack = b.stack_size <= kLocalStack ? local : deep_stack<TraversalEntry>(b.stack_size);
+      TraversalEntry* stack = b.stack_size <= kLocalStack ? local : deep_bvh2_stack(b.stack_size);
       return kmbvh::trace_bvh2(b.view(), ray, query, stack, hit);
     }
-    case Layout::Bvh4: return trace_one_wide(layouts_->bvh4, ray, query, hit, nullptr);
-    case Layout::Bvh8: return trace_one_wide(layouts_->bvh8, ray, query, hit, nullptr);
+    case Layout::Bvh4: return trace_wide_ray(layouts_->bvh4, ray, query, hit);
+    case Layout::Bvh8: return trace_wide_ray(layouts_->bvh8, ray, query, hit);
   }
   hit = Hit();
   return false;
@@ -134,8 +126,8 @@ bool Tracer::trace_one(const Ray& ray, Query query, Hit& hit) const {
 bool Tracer::trace_one(const Ray& ray, Query query, Hit& hit, const HitFilter& filter) const {
   switch (layout_) {
     case Layout::Bvh2: break;
-    case Layout::Bvh4: return trace_one_wide(layouts_->bvh4, ray, query, hit, &filter);
-    case Layout::Bvh8: return trace_one_wide(layouts_->bvh8, ray, query, hit, &filter);
+    case Layout::Bvh4: return trace_wide_ray(layouts_->bvh4, ray, query, hit, &filter);
+    case Layout::Bvh8: return trace_wide_ray(layouts_->bvh8, ray, query, hit, &filter);
   }
   throw std::logic_error("Tracer::trace_one: hit filters need a bvh4 or bvh8 layout");
 }

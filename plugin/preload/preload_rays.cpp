@@ -37,10 +37,14 @@ const SceneAccel* accel_for(RTCScene scene, const RTCIntersectContext* context) 
 }
 
 // kmbvh's answer written to the application's ray; under KMBVH_AB both systems' (ab_mode.h).
-inline void answer(const SceneAccel& accel, RTCScene scene, const RayRef& r, Query query, RTCIntersectContext* context,
-                   QueryForm form) {
-  if (ab_mode_on()) return ab_answer(accel, scene, r, query, context, form);
-  answer_with_kmbvh(accel, r, query, context);
+// `ref_of()` makes the ray's RayRef in each branch: one handed to the A/B mode's function
+// by reference must be built in memory, twenty pointers stored per query, while one used
+// only by the inlined kmbvh path becomes plain loads and stores of the ray's fields.
+template <typename RefOf>
+inline void answer(const SceneAccel& accel, RTCScene scene, const RefOf& ref_of, Query query,
+                   RTCIntersectContext* context, QueryForm form) {
+  if (ab_mode_on()) return ab_answer(accel, scene, ref_of(), query, context, form);
+  answer_with_kmbvh(accel, ref_of(), query, context);
 }
 
 // A query Embree answers: counted, and under KMBVH_AB reported for its scene and form.
@@ -64,7 +68,7 @@ void answer_rays(const SceneAccel& accel, RTCScene scene, Query query, RTCInters
                  unsigned n, const RefOf& ref_of) {
   if (ab_mode_on() || accel.has_filters(query)) {
     for (unsigned i = 0; i < n; ++i)
-      if (const std::optional<RayRef> r = ref_of(i)) answer(accel, scene, *r, query, context, form);
+      if (const std::optional<RayRef> r = ref_of(i)) answer(accel, scene, [&] { return *r; }, query, context, form);
     return;
   }
   const unsigned inst_id = context_inst_id(context);
@@ -171,7 +175,7 @@ void occluded_packet(const SceneAccel& accel, RTCScene scene, const int* valid, 
 
 KMBVH_EXPORT void rtcIntersect1(RTCScene scene, RTCIntersectContext* context, RTCRayHit* rayhit) {
   if (const SceneAccel* accel = rayhit ? accel_for(scene, context) : nullptr) {
-    answer(*accel, scene, ray_ref(*rayhit), Query::Closest, context, QueryForm::Intersect1);
+    answer(*accel, scene, [&] { return ray_ref(*rayhit); }, Query::Closest, context, QueryForm::Intersect1);
     count_kmbvh_rays(1);
     return;
   }
@@ -181,7 +185,7 @@ KMBVH_EXPORT void rtcIntersect1(RTCScene scene, RTCIntersectContext* context, RT
 
 KMBVH_EXPORT void rtcOccluded1(RTCScene scene, RTCIntersectContext* context, RTCRay* ray) {
   if (const SceneAccel* accel = ray ? accel_for(scene, context) : nullptr) {
-    answer(*accel, scene, ray_ref(*ray), Query::Any, context, QueryForm::Occluded1);
+    answer(*accel, scene, [&] { return ray_ref(*ray); }, Query::Any, context, QueryForm::Occluded1);
     count_kmbvh_rays(1);
     return;
   }
