@@ -91,6 +91,7 @@ PluginConfig read_plugin_config() {
   c.ab = read_ab_config();
   c.record_rays = env("KMBVH_RECORD_RAYS");
   if (const uint32_t n = env_count("KMBVH_RECORD_LIMIT", 1, 1u << 30)) c.record_limit = n;
+  if (const uint32_t n = env_count("KMBVH_RECORD_EVERY", 1, 1u << 30)) c.record_every = n;
   const std::string mesh_trees = env("KMBVH_MESH_TREES");
   if (mesh_trees == "0")
     c.mesh_trees = false;

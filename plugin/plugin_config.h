@@ -13,7 +13,7 @@
 //                  only) spoils kmbvh's answers so the oracle can be seen to fail
 //   KMBVH_RECORD_RAYS=FILE   the queries kmbvh answers on one scene, recorded for
 //                  `kmbvh trace --rays-file` (preload/ray_recorder.h); KMBVH_RECORD_LIMIT=N
-//                  queries at most (2,000,000)
+//                  queries at most (2,000,000), KMBVH_RECORD_EVERY=N one query in N
 #pragma once
 
 #include <embree3/rtcore.h>
@@ -49,6 +49,7 @@ struct PluginConfig {
   AbConfig ab;
   std::string record_rays;  // KMBVH_RECORD_RAYS: the file, or empty
   uint32_t record_limit = 2000000;
+  uint32_t record_every = 1;  // KMBVH_RECORD_EVERY: one query in this many is recorded
   bool mesh_trees = true;  // KMBVH_MESH_TREES=0: a dynamic scene's meshes under one tree (scene_accel.h)
 };
 

@@ -16,7 +16,8 @@ namespace {
 
 class Recorder {
  public:
-  Recorder() : path_(plugin_config().record_rays), limit_(plugin_config().record_limit) {}
+  Recorder()
+      : path_(plugin_config().record_rays), limit_(plugin_config().record_limit), every_(plugin_config().record_every) {}
 
   // The file, at exit: written whole, so a crash leaves no half file behind. Queries that
   // come later (threads still running) are not recorded.
@@ -43,6 +44,7 @@ class Recorder {
       return;  // another scene's
     std::lock_guard<std::mutex> lock(mutex_);
     if (rays_.size() >= limit_) return full_.store(true, std::memory_order_relaxed);
+    if (seen_++ % every_ != 0) return;
     rays_.push_back(AppRayRecord{{ray.org.x, ray.org.y, ray.org.z},
                                  {ray.dir.x, ray.dir.y, ray.dir.z},
                                  ray.tnear,
@@ -53,6 +55,8 @@ class Recorder {
  private:
   const std::string path_;
   const size_t limit_;
+  const uint64_t every_;
+  uint64_t seen_ = 0;  // the scene's queries so far, under the mutex
   std::atomic<const void*> scene_{nullptr};
   std::atomic<bool> full_{false};
   std::mutex mutex_;

@@ -2,7 +2,9 @@
 // `kmbvh trace SCENE --rays-file FILE` can time kmbvh against Embree on the application's
 // own rays, away from the application (adapters/rays/ray_file.h: the format). One scene's
 // rays are kept: the first scene a query is answered for (a renderer's scene; the log names
-// it); up to KMBVH_RECORD_LIMIT queries (default 2,000,000), the first ones. The file is
+// it); up to KMBVH_RECORD_LIMIT queries (default 2,000,000), the first ones, or with
+// KMBVH_RECORD_EVERY=N one in N (a renderer's first queries are its first tiles; one in N
+// samples the whole image). The file is
 // written when the process exits. Recording takes a lock per query: the application runs
 // slower while it records, so its timings then mean nothing.
 #pragma once

@@ -1,6 +1,7 @@
 # KMBVH_RECORD_RAYS (cmake -P): the scene client runs under the preload library recording
 # its queries, and `kmbvh trace --rays-file` then traces them with kmbvh and Embree: both
-# query kinds present, as many rays as the limit allowed, no mismatch.
+# query kinds present, as many rays as the limit allowed, no mismatch; and with
+# KMBVH_RECORD_EVERY, one query in N of the same run.
 #   -DCLIENT=kmbvh_scene_client -DPRELOAD=libkmbvh_preload.so -DKMBVH=kmbvh -DSCENE=file|default -DWORK=dir
 file(REMOVE_RECURSE "${WORK}")
 file(MAKE_DIRECTORY "${WORK}")
@@ -18,6 +19,33 @@ math(EXPR expected "8 + 36 * ${limit}")  # the magic, then one 36-byte record a 
 if(NOT bytes EQUAL expected)
   message(FATAL_ERROR "${rays}: ${bytes} bytes, expected ${expected}")
 endif()
+# KMBVH_RECORD_EVERY=7: the queries 0, 7, 14, ... of the same run (the client queries from one
+# thread, in one order), record for record.
+set(sampled "${WORK}/sampled.bin")
+set(every 7)
+set(kept 100)
+execute_process(COMMAND ${CMAKE_COMMAND} -E env "LD_PRELOAD=${PRELOAD}" "KMBVH_RECORD_RAYS=${sampled}"
+                        "KMBVH_RECORD_LIMIT=${kept}" "KMBVH_RECORD_EVERY=${every}" "${CLIENT}" trace "${SCENE}"
+                        "${WORK}/hits_sampled.bin"
+                RESULT_VARIABLE rc ERROR_VARIABLE log)
+if(NOT rc EQUAL 0 OR NOT log MATCHES "${kept} queries recorded to")
+  message(FATAL_ERROR "the client recording one query in ${every} failed or recorded too few (${rc}): ${log}")
+endif()
+file(READ "${sampled}" magic LIMIT 8 HEX)
+file(READ "${rays}" magic_all LIMIT 8 HEX)
+if(NOT magic STREQUAL magic_all)
+  message(FATAL_ERROR "${sampled}: no ray file's magic")
+endif()
+math(EXPR last "${kept} - 1")
+foreach(i RANGE ${last})
+  math(EXPR at "8 + 36 * ${i}")
+  math(EXPR at_all "8 + 36 * ${i} * ${every}")
+  file(READ "${sampled}" record OFFSET ${at} LIMIT 36 HEX)
+  file(READ "${rays}" record_all OFFSET ${at_all} LIMIT 36 HEX)
+  if(NOT record STREQUAL record_all)
+    message(FATAL_ERROR "sampled record ${i} is not query ${i} * ${every} of the whole recording")
+  endif()
+endforeach()
 execute_process(COMMAND "${KMBVH}" trace "${SCENE}" --rays-file "${rays}" --compare-embree --runs 1 --json --quiet
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out)
 if(NOT rc EQUAL 0)
