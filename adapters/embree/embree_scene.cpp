@@ -134,6 +134,8 @@ EmbreeScene::~EmbreeScene() {
   if (scene_) rtcReleaseScene(scene_);
 }
 
+void EmbreeScene::trace_one(const Ray& ray, Query query, Hit& hit) const { trace_single(scene_, ray, query, hit); }
+
 void EmbreeScene::trace(const std::vector<Ray>& rays, Query query, EmbreeRays form, std::vector<Hit>& hits) const {
   hits.resize(rays.size());
   trace(rays.data(), rays.size(), query, form, hits.data());

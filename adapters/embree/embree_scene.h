@@ -28,6 +28,8 @@ class EmbreeScene {
   // sent to it and come back as misses.
   void trace(const std::vector<Ray>& rays, Query query, EmbreeRays form, std::vector<Hit>& hits) const;
   void trace(const Ray* rays, size_t n, Query query, EmbreeRays form, Hit* hits) const;
+  // One ray on the calling thread (rtcIntersect1 / rtcOccluded1), as trace() answers it.
+  void trace_one(const Ray& ray, Query query, Hit& hit) const;
 
   double commit_ms() const { return commit_ms_; }
 

@@ -92,6 +92,7 @@ AppRays read_app_rays(const std::string& path, size_t limit) {
     ray.tnear = r.tnear;
     ray.tfar = r.tfar;
     out.push_back(ray);
+    rays.order.push_back(r.query == 0 ? Query::Closest : Query::Any);
   }
   if (in.gcount() != 0) throw RayFileError(fmt::format("{}: ends inside a ray (truncated)", path));
   return rays;

@@ -47,6 +47,7 @@ static_assert(sizeof(AppRayRecord) == 36, "the record is the file format");
 
 struct AppRays {
   std::vector<Ray> closest, occlusion;
+  std::vector<Query> order;  // the kept queries' kinds in the file's order (the application's)
 };
 // At most `limit` rays of each query, the first ones. Throws RayFileError naming the file
 // and what is wrong with it.

@@ -108,6 +108,7 @@ struct TraceCommand {
   size_t show = 5;               // mismatching rays printed in full
   std::string replay;            // an A/B report of the preload library: its rays instead (replay.cpp)
   std::string rays_file;         // an application's rays recorded by the preload (KMBVH_RECORD_RAYS) instead
+  bool in_order = false;         // with rays_file: also timed one query at a time in the application's order
 };
 
 // kmbvh stress [CASES...]: every builder on the generated stress cases.

@@ -190,6 +190,57 @@ Json comparison_json(const HitComparison& c) {
               {"first", first}};
 }
 
+// The recorded queries traced one at a time in the order the application sent them, as
+// an application's rtcIntersect1/rtcOccluded1 calls come: each thread takes a contiguous run
+// of the sequence (an application's thread traces its own tiles, a shadow ray after the
+// closest hit it leaves from), where the batches above trace each kind apart. Embree gains
+// from that order and kmbvh less (docs/design.md §8, "The kernel inside the application").
+struct InOrderResult {
+  size_t queries = 0;
+  double mrays = 0, embree_mrays = 0, ratio = 0;
+  size_t differences = 0;  // queries answered otherwise than by the batch traversal (must be 0)
+};
+
+InOrderResult trace_in_order(const Tracer& tracer, const RaySets& rays, const std::vector<Query>& order,
+                             const EmbreeScene* embree, const RunOptions& run) {
+  std::vector<Ray> sequence;  // the rays in the file's order
+  sequence.reserve(order.size());
+  size_t next[2] = {0, 0};
+  for (const Query q : order) {
+    const std::vector<Ray>& of_kind = q == Query::Any ? rays.app_occlusion : rays.app_closest;
+    sequence.push_back(of_kind[next[q == Query::Any]++]);
+  }
+  const long n = long(sequence.size());
+  std::vector<Hit> hits(sequence.size()), embree_hits(sequence.size());
+  const auto ours = [&] {
+#pragma omp parallel for schedule(static)
+    for (long i = 0; i < n; ++i) tracer.trace_one(sequence[size_t(i)], order[size_t(i)], hits[size_t(i)]);
+  };
+  InOrderResult r;
+  r.queries = sequence.size();
+  if (embree) {
+    const PairedTimes t = time_in_pairs(run.runs, run.warmup, ours, [&] {
+#pragma omp parallel for schedule(static)
+      for (long i = 0; i < n; ++i) embree->trace_one(sequence[size_t(i)], order[size_t(i)], embree_hits[size_t(i)]);
+    });
+    r.mrays = mrays(r.queries, t.ours_seconds);
+    r.embree_mrays = mrays(r.queries, t.theirs_seconds);
+    r.ratio = t.ratio;
+  } else {
+    r.mrays = mrays(r.queries, median_seconds(run.runs, run.warmup, ours));
+  }
+  std::vector<Hit> batch[2];
+  tracer.trace(rays.app_closest, Query::Closest, batch[0]);
+  tracer.trace(rays.app_occlusion, Query::Any, batch[1]);
+  next[0] = next[1] = 0;
+  for (size_t i = 0; i < sequence.size(); ++i) {
+    const bool any = order[i] == Query::Any;
+    const Hit& b = batch[any][next[any]++];
+    r.differences += any ? hits[i].found() != b.found() : std::memcmp(&hits[i], &b, sizeof(Hit)) != 0;
+  }
+  return r;
+}
+
 std::string hit_text(const Hit& h) {
   if (!h.found()) return "miss";
   return fmt::format("t={:.9g} u={:.6g} v={:.6g} Ng=({:.6g}, {:.6g}, {:.6g}) prim={}", h.t, h.u, h.v, h.Ng.x, h.Ng.y, h.Ng.z,
@@ -215,6 +266,10 @@ void add_trace_command(CLI::App& app, TraceCommand& c) {
                   "making rays: its closest-hit queries (app-closest) and its occlusion queries (app-occlusion), at "
                   "most --count of each")
       ->check(CLI::ExistingFile);
+  cmd->add_flag("--in-order", c.in_order,
+                "with --rays-file: also trace the queries one at a time in the order the application sent them "
+                "(app-in-order; Embree likewise with --compare-embree), each thread a contiguous run of them")
+      ->needs("--rays-file");
   cmd->add_option("--replay", c.replay,
                   "trace the mismatching rays an A/B report of the preload library recorded (KMBVH_AB_REPORT), on the "
                   "scene it saved beside them (the default for SCENE), with kmbvh and Embree")
@@ -228,11 +283,13 @@ int run_trace(const TraceCommand& c) {
   const std::vector<Layout>& layouts = c.layouts;
   std::vector<RayKind> kinds = c.rays;
   RaySets rays;
+  std::vector<Query> recorded_order;  // the recorded queries' kinds in the application's order
   if (!c.rays_file.empty()) {  // read first: a bad file is refused before the build
     try {
       AppRays recorded = read_app_rays(c.rays_file, c.count);
       rays.app_closest = std::move(recorded.closest);
       rays.app_occlusion = std::move(recorded.occlusion);
+      recorded_order = std::move(recorded.order);
     } catch (const RayFileError& e) {
       fmt::print(stderr, "kmbvh trace: {}\n", e.what());
       return kExitBadInput;
@@ -344,6 +401,12 @@ int run_trace(const TraceCommand& c) {
       }
       results.push_back(std::move(r));
     }
+    std::optional<InOrderResult> in_order;
+    if (c.in_order) {
+      progress.update(fmt::format("kmbvh {}: the queries in the application's order", to_string(layout)));
+      in_order = trace_in_order(tracer, rays, recorded_order, embree ? &*embree : nullptr, c.run);
+      mismatches += in_order->differences;
+    }
     const double traced_sah = sah_cost(traced_tree(bvh, layout));
     if (c.run.json) {
       Json kinds_json = Json::array();
@@ -374,6 +437,12 @@ int run_trace(const TraceCommand& c) {
                {"stack_size", tracer.stack_size()},
                {"kinds", kinds_json}};
       if (relayout_ms) row["relayout_ms"] = *relayout_ms;  // median, in the earlier layout's memory
+      if (in_order) {
+        Json o{{"queries", in_order->queries}, {"kmbvh_mrays_per_s", in_order->mrays},
+               {"differences", in_order->differences}};
+        if (embree) o["embree_mrays_per_s"] = in_order->embree_mrays, o["ratio_to_embree"] = in_order->ratio;
+        row["in_order"] = o;
+      }
       layout_rows.push_back(row);
       continue;
     }
@@ -408,6 +477,15 @@ int run_trace(const TraceCommand& c) {
                    "    kmbvh:  {}\n    embree: {}\n",
                    x.index, x.kind, x.ray.org.x, x.ray.org.y, x.ray.org.z, x.ray.dir.x, x.ray.dir.y, x.ray.dir.z, x.ray.tnear,
                    x.ray.tfar, hit_text(x.ours), hit_text(x.reference));
+    }
+    if (in_order) {
+      if (embree)
+        fmt::print("{:<13} {:>8} {:>13.2f} {:>13.2f} {:>7.2f}\n", "app-in-order", in_order->queries, in_order->mrays,
+                   in_order->embree_mrays, in_order->ratio);
+      else
+        fmt::print("{:<13} {:>8} {:>13.2f}\n", "app-in-order", in_order->queries, in_order->mrays);
+      fmt::print("  both kinds one query at a time in the application's order; {} answered otherwise than in the "
+                 "batches\n", in_order->differences);
     }
   }
   progress.done();

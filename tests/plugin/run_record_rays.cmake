@@ -1,7 +1,8 @@
 # KMBVH_RECORD_RAYS (cmake -P): the scene client runs under the preload library recording
 # its queries, and `kmbvh trace --rays-file` then traces them with kmbvh and Embree: both
-# query kinds present, as many rays as the limit allowed, no mismatch; and with
-# KMBVH_RECORD_EVERY, one query in N of the same run.
+# query kinds present, as many rays as the limit allowed, no mismatch, the same answers one
+# query at a time in the recorded order (--in-order); and with KMBVH_RECORD_EVERY, one query
+# in N of the same run.
 #   -DCLIENT=kmbvh_scene_client -DPRELOAD=libkmbvh_preload.so -DKMBVH=kmbvh -DSCENE=file|default -DWORK=dir
 file(REMOVE_RECURSE "${WORK}")
 file(MAKE_DIRECTORY "${WORK}")
@@ -46,7 +47,8 @@ foreach(i RANGE ${last})
     message(FATAL_ERROR "sampled record ${i} is not query ${i} * ${every} of the whole recording")
   endif()
 endforeach()
-execute_process(COMMAND "${KMBVH}" trace "${SCENE}" --rays-file "${rays}" --compare-embree --runs 1 --json --quiet
+execute_process(COMMAND "${KMBVH}" trace "${SCENE}" --rays-file "${rays}" --in-order --compare-embree --runs 1 --json
+                        --quiet
                 RESULT_VARIABLE rc OUTPUT_VARIABLE out)
 if(NOT rc EQUAL 0)
   message(FATAL_ERROR "kmbvh trace --rays-file failed (${rc}): ${out}")
@@ -60,6 +62,13 @@ math(EXPR traced "${n0} + ${n1}")
 if(NOT mismatches EQUAL 0 OR NOT closest STREQUAL "app-closest" OR NOT occlusion STREQUAL "app-occlusion"
    OR NOT traced EQUAL limit)
   message(FATAL_ERROR "expected ${limit} recorded rays of both kinds traced with no mismatch: ${out}")
+endif()
+# --in-order: every query once more, one at a time in the recorded order, as the batches answer it.
+string(JSON in_order GET "${out}" layouts 0 in_order queries)
+string(JSON differences GET "${out}" layouts 0 in_order differences)
+string(JSON embree_rate GET "${out}" layouts 0 in_order embree_mrays_per_s)
+if(NOT in_order EQUAL limit OR NOT differences EQUAL 0 OR NOT embree_rate GREATER 0)
+  message(FATAL_ERROR "expected ${limit} queries traced in order by both, as the batches answer them: ${out}")
 endif()
 # A file that is not a ray file is refused with a message naming it.
 execute_process(COMMAND "${KMBVH}" trace default --rays-file "${CMAKE_CURRENT_LIST_FILE}" --quiet
