@@ -189,23 +189,24 @@ TEST(Ploc, BlockedSearchPicksTheSameNeighbours) {
 }
 
 // PLOC's clustering as the GPU runs it, a step at a time (the per-cluster search or the
-// positional pairs, the counts, their exclusive scan, the merge), or as the CPU runs it
-// (ploc_iteration_cpu: one parallel region), from the leaves' boxes in their order to one cluster.
+// positional pairs, the counts, their exclusive scan, the merge, the boxes gathered), or as
+// the CPU runs it (ploc_iteration_cpu: one parallel region), from the leaves' boxes in their
+// order to one cluster.
 struct PlocRun {
   std::vector<uint32_t> left, right, parent, clusters, next_clusters, nearest;
   std::vector<Aabb> box;
-  std::vector<float> columns, next_columns;
+  std::vector<float> columns;
   uint32_t iterations = 0, paired = 0;
 
   PlocRun(const std::vector<Aabb>& leaves, bool fused) {
     const auto n = uint32_t(leaves.size());
     left.resize(n - 1), right.resize(n - 1), parent.resize(2 * n - 1), box.resize(2 * n - 1);
     clusters.resize(n), next_clusters.resize(n), nearest.resize(n);
-    columns.resize(6 * size_t(n)), next_columns.resize(6 * size_t(n));
+    columns.resize(6 * size_t(n));
     BinaryTreeView tree;
     tree.n = n, tree.left = left.data(), tree.right = right.data(), tree.parent = parent.data();
     tree.box = box.data();
-    BoxColumns cluster_box{columns.data(), n}, next_box{next_columns.data(), n};
+    const BoxColumns cluster_box{columns.data(), n};
     for (uint32_t i = 0; i < n; ++i) box[i] = leaves[i], cluster_box.set(i, leaves[i]), clusters[i] = i;
     uint32_t count = n, next_inner = n;
     bool stalled = false;
@@ -214,7 +215,7 @@ struct PlocRun {
       const bool pair = stalled || iterations % 3 == 2;
       paired += pair;
       MergeAndCompact merge{clusters.data(), cluster_box, nearest.data(), nullptr, next_inner, tree,
-                            next_clusters.data(), next_box};
+                            next_clusters.data()};
       MergeCounts total;
       if (fused) {
         total = ploc_iteration_cpu(count, 16, pair, cluster_box, nearest.data(), merge);
@@ -234,9 +235,10 @@ struct PlocRun {
         }
         merge.offsets = offsets.data();
         for (uint32_t i = 0; i < count; ++i) merge(i);
+        const GatherClusterBoxes gather{next_clusters.data(), box.data(), cluster_box};
+        for (uint32_t k = 0; k < total.kept; ++k) gather(k);
       }
       std::swap(clusters, next_clusters);
-      std::swap(cluster_box, next_box);
       next_inner += total.merges;
       stalled = !stalled && ploc_stalled(total.merges, count);
       count = total.kept;

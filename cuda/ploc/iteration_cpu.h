@@ -2,9 +2,10 @@
 // and a scan (ploc.inl): the nearest neighbours (find_nearest_cpu.h, or positions paired
 // after a stalled iteration), then each thread counts the merges and survivors of its
 // share of the positions, and after a barrier merges and compacts its share at the offsets
-// of the shares before it (MergeAndCompact::at). No per-position counts, no scan over
-// them, one fork and join an iteration; iterations of few clusters (the top of the tree)
-// run on one thread. The same tree as the GPU's steps.
+// of the shares before it (MergeAndCompact::at), and after another gathers the boxes of the
+// survivors it wrote into the columns (GatherClusterBoxes). No per-position counts, no scan
+// over them, one fork and join an iteration; iterations of few clusters (the top of the
+// tree) run on one thread. The same tree as the GPU's steps.
 #pragma once
 
 #include <omp.h>
@@ -22,8 +23,8 @@ constexpr uint32_t kPlocCpuMaxRadius = 32;
 constexpr uint32_t kPlocCpuBlock = 256;
 constexpr uint32_t kPlocClustersPerThread = 4096;  // fewer: one thread (no fork, no barrier)
 
-// The iteration's totals: pairs merged and clusters left. `merge` writes the next clusters;
-// its offsets are not read.
+// The iteration's totals: pairs merged and clusters left. `merge` writes the next clusters,
+// whose boxes then replace the clusters' in `box`; its offsets are not read.
 inline MergeCounts ploc_iteration_cpu(uint32_t count, uint32_t radius, bool paired, BoxColumns box,
                                       uint32_t* nearest, const MergeAndCompact& merge) {
   count_launch();
@@ -52,11 +53,17 @@ inline MergeCounts ploc_iteration_cpu(uint32_t count, uint32_t radius, bool pair
 #pragma omp barrier
     MergeCounts before;
     for (uint32_t u = 0; u < t; ++u) before = AddMergeCounts{}(before, shares[u + 1]);
+    const uint32_t first_kept = before.kept;
     for (uint32_t i = begin; i < end; ++i) {
       merge.at(i, before);
       before = AddMergeCounts{}(before, merge_counts(nearest, i));
     }
     if (t + 1 == parts) shares[0] = before;  // the last share ends at the totals
+    // Once every share has merged (the columns are read until then), each gathers the boxes
+    // of the survivors it wrote.
+#pragma omp barrier
+    const GatherClusterBoxes gather{merge.next_clusters, merge.tree.box, box};
+    for (uint32_t k = first_kept; k < before.kept; ++k) gather(k);
   }
   return shares[0];
 }

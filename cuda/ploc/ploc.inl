@@ -18,10 +18,17 @@
 namespace kmbvh {
 namespace KMBVH_BACKEND_NAMESPACE {
 
-struct CopyToColumns {
-  const Aabb* boxes;
+// Leaf i (position i in Morton order): its primitive's box, in the tree and in the columns
+// the first iteration searches.
+struct SetLeafBoxes {
+  BinaryTreeView tree;
+  const Aabb* prim_boxes;
   BoxColumns columns;
-  KMBVH_HD void operator()(uint32_t i) const { columns.set(i, boxes[i]); }
+  KMBVH_HD void operator()(uint32_t i) const {
+    const Aabb box = prim_boxes[tree.order[i]];
+    tree.box[i] = box;
+    columns.set(i, box);
+  }
 };
 
 // The nearest-neighbour search, sized by the radius (its window is a local array).
@@ -35,7 +42,8 @@ inline void find_nearest(uint32_t count, uint32_t radius, BoxColumns box, Buffer
 }
 
 // One iteration as the GPU runs it, a step a launch: the neighbours, the merges counted and
-// scanned, the survivors compacted. Returns the merges and the clusters left.
+// scanned, the survivors compacted, their boxes gathered into `box` for the next one.
+// Returns the merges and the clusters left.
 inline MergeCounts ploc_iteration(uint32_t count, uint32_t radius, bool paired, BoxColumns box,
                                   Buffer<uint32_t>& nearest, Buffer<MergeCounts>& counts,
                                   Buffer<MergeCounts>& offsets, MergeAndCompact merge) {
@@ -49,6 +57,7 @@ inline MergeCounts ploc_iteration(uint32_t count, uint32_t radius, bool paired, 
   const MergeCounts total = AddMergeCounts{}(read(offsets, count - 1), read(counts, count - 1));
   merge.offsets = ptr(offsets);
   for_each_index(count, merge);
+  for_each_index(total.kept, GatherClusterBoxes{merge.next_clusters, merge.tree.box, box});
   return total;
 }
 
@@ -72,13 +81,11 @@ inline Bvh build_ploc(const PrimitiveSet& prims, const BinaryBuildParams& params
   tree.parent = ptr(parent);
   tree.box = ptr(node_box);
   tree.order = ptr(order);
-  CollapseState state(n);
-  for_each_index(n, InitLeaves{tree, state.view(), params.sah, boxes.data()});
 
   Buffer<uint32_t> clusters(n), next_clusters(n), nearest(n);
-  Buffer<float> box_columns[2] = {Buffer<float>(6 * size_t(n)), Buffer<float>(6 * size_t(n))};
-  BoxColumns cluster_box{ptr(box_columns[0]), n}, next_box{ptr(box_columns[1]), n};
-  for_each_index(n, CopyToColumns{tree.box, cluster_box});
+  Buffer<float> box_columns(6 * size_t(n));
+  const BoxColumns cluster_box{ptr(box_columns), n};
+  for_each_index(n, SetLeafBoxes{tree, boxes.data(), cluster_box});
 #if KMBVH_BACKEND_CPU
   // An iteration in one parallel region (iteration_cpu.h), with no counts to scan.
   const bool fused = params.ploc_radius <= kPlocCpuMaxRadius;
@@ -93,7 +100,7 @@ inline Bvh build_ploc(const PrimitiveSet& prims, const BinaryBuildParams& params
     if (info) ++info->levels;
     if (stalled && info) ++info->forced_splits;
     const MergeAndCompact merge{ptr(clusters), cluster_box, ptr(nearest), nullptr, next_inner, tree,
-                                ptr(next_clusters), next_box};
+                                ptr(next_clusters)};
     MergeCounts total;
 #if KMBVH_BACKEND_CPU
     if (fused) total = ploc_iteration_cpu(count, params.ploc_radius, stalled, cluster_box, ptr(nearest), merge);
@@ -101,15 +108,17 @@ inline Bvh build_ploc(const PrimitiveSet& prims, const BinaryBuildParams& params
     if (!fused)
       total = ploc_iteration(count, params.ploc_radius, stalled, cluster_box, nearest, counts, offsets, merge);
     std::swap(clusters, next_clusters);
-    std::swap(cluster_box, next_box);
     next_inner += total.merges;
     stalled = !stalled && ploc_stalled(total.merges, count);
     count = total.kept;
   }
   tree.root = read(clusters, 0);
   write(parent, tree.root, kNoParent);
-  release(clusters, next_clusters, nearest, counts, offsets, box_columns[0], box_columns[1]);
+  release(clusters, next_clusters, nearest, counts, offsets, box_columns);
   clock.lap("clustering");
+  // Made now, in the memory the clustering's buffers leave (18 bytes a primitive off the
+  // build's peak); collapse() sets the leaves' part.
+  CollapseState state(n);
   collapse(tree, state, params.max_leaf_size, params.sah, /*refit=*/false);
   clock.lap("collapse");
   Bvh bvh = lay_out(tree, state.view());
