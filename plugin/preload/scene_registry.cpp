@@ -53,6 +53,7 @@ struct SceneRecord {
   std::atomic<bool> embree_current{true};  // false while kmbvh has deferred Embree's commit
   std::mutex commit_mutex;                  // one build at a time (rtcJoinCommitScene)
   BuildContext build_context;               // kept for the next commit's build, under commit_mutex
+  uint32_t builds = 0;                      // kmbvh's builds of the scene (not refits), under commit_mutex
   std::string last_fallback;                // logged when it changes
 };
 
@@ -523,8 +524,15 @@ void commit_or_build(RTCScene scene, bool join) {
   AccelReport report;
   try {
     if (!input) input = std::make_unique<CommitMeshes>(meshes);
-    accel = std::make_unique<SceneAccel>(std::move(*input), std::move(filters), quality, report, &s->build_context,
-                                         dynamic, s->owned.get());
+    // A static scene's first build goes without a context: most are built once (a renderer's
+    // scene), and a build without one frees its working memory before the layout is made,
+    // where a context would hold it for the scene's life (Embree's pathtracer's peak RSS:
+    // conference 129.6 -> 100.8 MB, sponza 37.9 -> 31.7). One built again keeps its build
+    // memory from then on; a dynamic scene keeps it from the first.
+    BuildContext* context = dynamic || s->builds > 0 ? &s->build_context : nullptr;
+    accel = std::make_unique<SceneAccel>(std::move(*input), std::move(filters), quality, report, context, dynamic,
+                                         s->owned.get());
+    ++s->builds;
   } catch (const std::exception& e) {
     return commit_by_embree(scene, *s, join, std::string("kmbvh could not build it: ") + e.what(), instanced);
   }

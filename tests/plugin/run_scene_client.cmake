@@ -50,6 +50,22 @@ if(OPTIONS MATCHES "--scatter" AND EXPECT STREQUAL "kmbvh")
     message(FATAL_ERROR "the scattered scene's second commit was not built again as expected (${expected}):\n${preload_log}")
   endif()
 endif()
+# A static scene built three times (--recommit): the first build keeps no memory for the
+# next, the second keeps it, and the third allocates nothing (scene_registry.cpp).
+if(OPTIONS MATCHES "--recommit" AND EXPECT STREQUAL "kmbvh")
+  string(REGEX MATCHALL "triangles in [0-9]+ meshes[^\n]*, [0-9]+ backend allocations" builds "${preload_log}")
+  list(LENGTH builds count)
+  if(NOT count EQUAL 3)
+    message(FATAL_ERROR "expected three builds of the recommitted scene:\n${preload_log}")
+  endif()
+  list(GET builds 0 first)
+  list(GET builds 1 second)
+  list(GET builds 2 third)
+  if(first MATCHES ", 0 backend allocations" OR second MATCHES ", 0 backend allocations"
+     OR NOT third MATCHES ", 0 backend allocations")
+    message(FATAL_ERROR "expected backend allocations in the first two builds and none in the third:\n${preload_log}")
+  endif()
+endif()
 execute_process(COMMAND "${CLIENT}" compare "${SCENE}" "${WORK}/embree.bin" "${WORK}/kmbvh.bin" ${OPTIONS} ${exact}
                 RESULT_VARIABLE rc)
 if(NOT rc EQUAL 0)
