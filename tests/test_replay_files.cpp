@@ -130,7 +130,7 @@ TEST(RayFile, ApplicationRaysReadBackByQueryUpToTheLimit) {
   ASSERT_EQ(first.closest.size(), 2u);
   ASSERT_EQ(first.occlusion.size(), 2u);
   EXPECT_EQ(first.occlusion[1].org.x, 3.0f);
-  // The kept queries' kinds in the file's order: 0 to 3 alternate, 4 to 6 are past the limit.
+  // The kept queries' kinds in the file's order (with a limit of two of each, 4 to 6 are past it).
   EXPECT_EQ(all.order, (std::vector<Query>{Query::Closest, Query::Any, Query::Closest, Query::Any, Query::Closest,
                                           Query::Any, Query::Closest}));
   EXPECT_EQ(first.order, (std::vector<Query>{Query::Closest, Query::Any, Query::Closest, Query::Any}));
