@@ -11,6 +11,7 @@
 #include <utility>
 
 #include "cuda/core/parallel_errors.h"
+#include "deep_stack.h"
 #include "cuda/traversal/ray_box.h"
 #include "cuda/traversal/watertight.h"
 
@@ -25,16 +26,6 @@ TraversalCounters& TraversalCounters::operator+=(const TraversalCounters& o) {
   exact_retraces += o.exact_retraces;
   return *this;
 }
-
-namespace {
-// A stack for trees deeper than trace_wide_ray's stack on the C++ stack holds: one per
-// thread, kept (no tree seen in practice needs it).
-WideEntry* deep_stack(uint32_t size) {
-  thread_local std::vector<WideEntry> stack;
-  if (stack.size() < size) stack.resize(size);
-  return stack.data();
-}
-}  // namespace
 
 // The kernel once per instruction set (trace_wide_kernel.inl). This file is compiled for
 // x86-64-v2 (adapters/CMakeLists.txt), and so is the SSE4.2 variant; the AVX2 and AVX-512

@@ -488,16 +488,13 @@ __attribute__((always_inline)) inline bool finish_hit(const WideBvh<W>& bvh, uin
 template <int W>
 __attribute__((always_inline)) inline void float_hit(const WideBvh<W>& bvh, uint32_t found, const PackRay& r,
                                                      Hit& hit) {
+  finish_hit(bvh, found, ExactCheck(), hit);  // ids and Ng; an unmeasured check leaves t, u and v
   const TrianglePack& p = bvh.packs[found / kPackWidth];
   const uint32_t slot = found % kPackWidth;
-  hit.geomID = p.id[slot].geom;
-  hit.primID = p.id[slot].prim;
-  const Vec3 a = slot_vertex(p, 0, slot), b = slot_vertex(p, 1, slot), c = slot_vertex(p, 2, slot);
   Hit h;
-  if (intersect_watertight(r.shear, r.ray.tnear, std::numeric_limits<float>::infinity(), a, b, c, h)) {
+  if (intersect_watertight(r.shear, r.ray.tnear, std::numeric_limits<float>::infinity(), slot_vertex(p, 0, slot),
+                           slot_vertex(p, 1, slot), slot_vertex(p, 2, slot), h))
     hit.u = h.u, hit.v = h.v;
-  }
-  hit.Ng = cross(b - a, c - a);
 }
 
 // A ray's end: its counts, when counted, go to `counted`.
@@ -789,7 +786,7 @@ constexpr uint32_t kLocalStack = 512;
 template <int W>
 bool trace_one(const WideBvh<W>& bvh, const Ray& ray, Query query, Hit& hit, const HitFilter* filter) {
   WideEntry local[kLocalStack];
-  WideEntry* stack = bvh.stack_size <= kLocalStack ? local : deep_stack(bvh.stack_size);
+  WideEntry* stack = bvh.stack_size <= kLocalStack ? local : deep_stack<WideEntry>(bvh.stack_size);
   if (filter) {
     return query == Query::Any ? traverse<W, Query::Any, true>(bvh, ray, stack, hit, filter)
                                : traverse<W, Query::Closest, true>(bvh, ray, stack, hit, filter);

@@ -5,6 +5,7 @@
 
 #include "bvh2_layout.h"
 #include "collapse_wide.h"
+#include "deep_stack.h"
 #include "cuda/traversal/traverse_bvh2.h"
 #include "trace_wide.h"
 #include "wide_bvh.h"
@@ -97,14 +98,8 @@ std::optional<TraversalCounters> Tracer::count(const std::vector<Ray>& rays, Que
 namespace {
 
 // The portable BVH2 kernel's stack in trace_one: on the C++ stack up to this many entries
-// (6 KiB); a deeper tree gets a thread-local buffer.
+// (6 KiB); a deeper tree gets a thread-local buffer (deep_stack.h).
 constexpr uint32_t kLocalStack = 512;
-
-TraversalEntry* deep_bvh2_stack(uint32_t size) {
-  thread_local std::vector<TraversalEntry> stack;
-  if (stack.size() < size) stack.resize(size);
-  return stack.data();
-}
 
 }  // namespace
 
@@ -113,7 +108,7 @@ bool Tracer::trace_one(const Ray& ray, Query query, Hit& hit) const {
     case Layout::Bvh2: {
       const Bvh2& b = layouts_->bvh2;
       TraversalEntry local[kLocalStack];
-      TraversalEntry* stack = b.stack_size <= kLocalStack ? local : deep_bvh2_stack(b.stack_size);
+      TraversalEntry* stack = b.stack_size <= kLocalStack ? local : deep_stack<TraversalEntry>(b.stack_size);
       return kmbvh::trace_bvh2(b.view(), ray, query, stack, hit);
     }
     case Layout::Bvh4: return trace_wide_ray(layouts_->bvh4, ray, query, hit);

@@ -103,6 +103,7 @@ struct KindResult {
   double packet_mrays = 0, packet_embree_mrays = 0, packet_ratio = 0;
   size_t packet_differences = 0;
   std::optional<TraversalCounters> packet_counters;
+  std::vector<Hit> hits;  // the batch's answers, kept for --in-order to compare with
 };
 
 // A count over the batch's rays, as an average per ray.
@@ -201,8 +202,10 @@ struct InOrderResult {
   size_t differences = 0;  // queries answered otherwise than by the batch traversal (must be 0)
 };
 
+// batch[0], batch[1]: the batches' answers to the closest-hit and the occlusion queries.
 InOrderResult trace_in_order(const Tracer& tracer, const RaySets& rays, const std::vector<Query>& order,
-                             const EmbreeScene* embree, const RunOptions& run) {
+                             const std::vector<Hit>* const (&batch)[2], const EmbreeScene* embree,
+                             const RunOptions& run) {
   std::vector<Ray> sequence;  // the rays in the file's order
   sequence.reserve(order.size());
   size_t next[2] = {0, 0};
@@ -229,13 +232,10 @@ InOrderResult trace_in_order(const Tracer& tracer, const RaySets& rays, const st
   } else {
     r.mrays = mrays(r.queries, median_seconds(run.runs, run.warmup, ours));
   }
-  std::vector<Hit> batch[2];
-  tracer.trace(rays.app_closest, Query::Closest, batch[0]);
-  tracer.trace(rays.app_occlusion, Query::Any, batch[1]);
   next[0] = next[1] = 0;
   for (size_t i = 0; i < sequence.size(); ++i) {
     const bool any = order[i] == Query::Any;
-    const Hit& b = batch[any][next[any]++];
+    const Hit& b = (*batch[any])[next[any]++];
     r.differences += any ? hits[i].found() != b.found() : std::memcmp(&hits[i], &b, sizeof(Hit)) != 0;
   }
   return r;
@@ -399,12 +399,16 @@ int run_trace(const TraceCommand& c) {
         r.comparison = compare_hits(scene.geometry, rays.of(kind), query_for(kind), hits, r.embree->hits, c.show);
         mismatches += r.comparison.mismatches();
       }
+      if (c.in_order) r.hits = std::move(hits);
       results.push_back(std::move(r));
     }
     std::optional<InOrderResult> in_order;
     if (c.in_order) {
       progress.update(fmt::format("kmbvh {}: the queries in the application's order", to_string(layout)));
-      in_order = trace_in_order(tracer, rays, recorded_order, embree ? &*embree : nullptr, c.run);
+      static const std::vector<Hit> kNone;  // a kind the file has no query of
+      const std::vector<Hit>* batch[2] = {&kNone, &kNone};
+      for (const KindResult& r : results) batch[r.kind == RayKind::AppOcclusion] = &r.hits;
+      in_order = trace_in_order(tracer, rays, recorded_order, batch, embree ? &*embree : nullptr, c.run);
       mismatches += in_order->differences;
     }
     const double traced_sah = sah_cost(traced_tree(bvh, layout));
