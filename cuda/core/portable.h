@@ -10,8 +10,6 @@
 
 #include <thrust/copy.h>
 #include <thrust/device_allocator.h>
-#include <thrust/device_free.h>
-#include <thrust/device_malloc.h>
 #include <thrust/device_vector.h>
 #include <thrust/execution_policy.h>
 #include <thrust/for_each.h>
@@ -24,8 +22,6 @@
 
 #include <chrono>
 #include <cstdint>
-#include <map>
-#include <new>
 #include <type_traits>
 #include <vector>
 
@@ -34,6 +30,7 @@
 #include "build_context.h"
 #include "build_info.h"
 #include "huge_pages.h"
+#include "memory_pool.h"
 #if KMBVH_BACKEND_CPU
 #include "radix_sort_cpu.h"
 #endif
@@ -41,7 +38,6 @@
 namespace kmbvh {
 namespace KMBVH_BACKEND_NAMESPACE {
 
-class MemoryPool;
 inline thread_local MemoryPool* current_pool = nullptr;  // the build's (UsePool), if any
 
 // Working buffers are not value-initialised: kernels write what they later read, so
@@ -62,6 +58,7 @@ struct UninitializedAllocator : thrust::device_allocator<T> {
     using other = UninitializedAllocator<U>;
   };
   UninitializedAllocator() = default;
+  explicit UninitializedAllocator(MemoryPool* from) : pool(from) {}  // a buffer that lives longer than a build
   template <typename U>
   UninitializedAllocator(const UninitializedAllocator<U>& other) : pool(other.pool) {}
 
@@ -103,78 +100,6 @@ size_t bytes_reserved(const Buffer<T>& b) {
   return b.capacity() * sizeof(T);
 }
 
-// Backend memory of one size, fresh from the system: device memory on the GPU, host memory
-// on huge pages on the CPU. Counted; throws std::bad_alloc when there is none.
-inline char* allocate_fresh(size_t bytes) {
-  count_allocation(bytes);
-  char* p = thrust::raw_pointer_cast(thrust::device_malloc<char>(bytes));
-  if (!p && bytes > 0) throw std::bad_alloc();  // Thrust's malloc returns null when out of memory
-#if KMBVH_BACKEND_CPU
-  advise_huge_pages(p, bytes);
-#endif
-  return p;
-}
-inline void free_fresh(char* p) { thrust::device_free(thrust::device_pointer_cast(p)); }
-
-// Backend memory in blocks kept for reuse: Thrust's temporaries (a scan's partial sums,
-// CUB's scratch space), and the buffers made inside a build that uses the pool (UsePool).
-// Blocks come in power-of-two sizes, go back to their size's free list when given back and
-// are freed only with the pool, so a build asking for what the last one asked (the same
-// sizes, as many at once) takes every block from the lists: no cudaMalloc, no fresh page.
-// As CUB's caching allocator bins its blocks. A pool made with keep = false frees each
-// block when it is given back.
-class MemoryPool {
- public:
-  using value_type = char;
-  explicit MemoryPool(bool keep = true) : keep_(keep) {}
-  MemoryPool(const MemoryPool&) = delete;
-  MemoryPool& operator=(const MemoryPool&) = delete;
-  ~MemoryPool() {
-    for (auto& [size, blocks] : free_)
-      for (char* p : blocks) free_fresh(p);
-    for (const auto& [p, size] : used_) free_fresh(p);
-  }
-
-  char* allocate(std::ptrdiff_t n) {
-    const size_t size = size_class(size_t(n));
-    std::vector<char*>& blocks = free_[size];
-    char* p;
-    if (blocks.empty()) {
-      p = allocate_fresh(size);
-      held_ += size;
-    } else {
-      p = blocks.back();
-      blocks.pop_back();
-    }
-    used_.emplace(p, size);
-    return p;
-  }
-  void deallocate(char* p, size_t) {
-    const auto it = used_.find(p);
-    const size_t size = it->second;
-    used_.erase(it);
-    if (keep_) {
-      free_[size].push_back(p);
-    } else {
-      free_fresh(p);
-      held_ -= size;
-    }
-  }
-  size_t bytes_held() const { return held_; }
-
- private:
-  static size_t size_class(size_t n) {
-    size_t size = 256;
-    while (size < n) size <<= 1;
-    return size;
-  }
-
-  bool keep_;
-  std::map<size_t, std::vector<char*>> free_;  // by size
-  std::map<char*, size_t> used_;
-  size_t held_ = 0;
-};
-
 template <typename T>
 typename UninitializedAllocator<T>::pointer UninitializedAllocator<T>::allocate(size_type n) {
   if (pool) return pointer(reinterpret_cast<T*>(pool->allocate(std::ptrdiff_t(n * sizeof(T)))));
@@ -198,10 +123,13 @@ inline MemoryPool& scratch() {
 }
 
 // Makes `pool` the build's while it lives: Thrust's temporaries and every buffer made
-// meanwhile take their memory from it.
+// meanwhile take their memory from it. A build begins there (MemoryPool::begin_build).
 class UsePool {
  public:
-  explicit UsePool(MemoryPool& pool) : previous_(current_pool) { current_pool = &pool; }
+  explicit UsePool(MemoryPool& pool) : previous_(current_pool) {
+    if (previous_ != &pool) pool.begin_build();
+    current_pool = &pool;
+  }
   ~UsePool() { current_pool = previous_; }
   UsePool(const UsePool&) = delete;
   UsePool& operator=(const UsePool&) = delete;

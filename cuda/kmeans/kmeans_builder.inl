@@ -55,10 +55,13 @@
 namespace kmbvh {
 namespace KMBVH_BACKEND_NAMESPACE {
 
-// The level loop's memory, kept in a BuildContext from one build to the next: every buffer
-// keeps its capacity, so a build no larger than the last allocates nothing.
+// The level loop's memory, kept in a BuildContext from one build to the next. Every buffer
+// takes its memory from the workspace's pool, which keeps it: a build gives each buffer
+// back as soon as it is done with it, so that the next (the finishing step's) can take
+// the same memory, and a build asking for what the last one asked allocates nothing
+// (memory_pool.h).
 struct KMeansWorkspace : BuildContext::Workspace {
-  MemoryPool scratch;  // Thrust's temporaries, and the buffers a build makes for itself
+  MemoryPool scratch;  // every buffer's, and Thrust's temporaries
   Buffer<Aabb> boxes[2];
   Buffer<uint32_t> ids[2];
   Buffer<uint32_t> final_ids;
@@ -77,29 +80,34 @@ struct KMeansWorkspace : BuildContext::Workspace {
   Buffer<uint32_t> forced;  // segments split by index, counted on the device
   Buffer<BvhNode> nodes;
   Buffer<BvhNode> subtree_nodes;  // the CPU subtree path's (split_subtrees)
-  // Host memory of the finishing step: the nodes as built, and the breadth-first order's scratch.
+  // Host memory of the finishing step: the nodes as built (the GPU's), and the breadth-first
+  // order's scratch.
   std::vector<BvhNode> built_nodes;
   std::vector<uint32_t> order_scratch;
 
+  // keep = false: a build's own workspace, whose buffers go back to the system as soon as
+  // they are done with (the finishing step's host memory then takes their pages).
+  explicit KMeansWorkspace(bool keep = true) : scratch(keep) {
+    take_from_scratch(boxes[0], boxes[1], ids[0], ids[1], final_ids, cluster_of, segments, next_segments,
+                      segment_offsets, pieces, piece_counters, counters_scanned, reps, sums, counts, bounds,
+                      cluster_begin, cluster_segment, child_counts, child_offsets, forced, nodes, subtree_nodes);
+  }
+  template <typename... Buffers>
+  void take_from_scratch(Buffers&... buffers) {
+    (..., (buffers = Buffers(typename Buffers::allocator_type(&scratch))));
+  }
+
   size_t bytes_held() const override {
     return built_nodes.capacity() * sizeof(BvhNode) + order_scratch.capacity() * sizeof(uint32_t) +
-           scratch.bytes_held() + bytes_reserved(boxes[0]) + bytes_reserved(boxes[1]) + bytes_reserved(ids[0]) +
-           bytes_reserved(ids[1]) + bytes_reserved(final_ids) + bytes_reserved(cluster_of) +
-           bytes_reserved(segments) + bytes_reserved(next_segments) + bytes_reserved(segment_offsets) +
-           bytes_reserved(pieces) + bytes_reserved(piece_counters) + bytes_reserved(counters_scanned) +
-           bytes_reserved(reps) + bytes_reserved(sums) + bytes_reserved(counts) + bytes_reserved(bounds) + bytes_reserved(cluster_begin) +
-           bytes_reserved(cluster_segment) + bytes_reserved(child_counts) + bytes_reserved(child_offsets) +
-           bytes_reserved(forced) + bytes_reserved(nodes) + bytes_reserved(subtree_nodes);
+           scratch.bytes_held();
   }
 };
 
 template <uint32_t KMax, ClusterMetric M>
 class KMeansLevels {
  public:
-  // `keep`: the workspace is a context's, and keeps its memory for the next build.
-  KMeansLevels(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info, KMeansWorkspace& ws,
-               bool keep)
-      : params_(params), n_(static_cast<uint32_t>(prims.size())), info_(info), clock_(info), ws_(ws), keep_(keep) {
+  KMeansLevels(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info, KMeansWorkspace& ws)
+      : params_(params), n_(static_cast<uint32_t>(prims.size())), info_(info), clock_(info), ws_(ws) {
     count_host_sync();  // the boxes' upload
     boxes_[0].assign(prims.boxes.begin(), prims.boxes.end());
     boxes_[1].resize(n_);
@@ -366,45 +374,56 @@ class KMeansLevels {
       for (uint32_t i = 1; i < sub.count; ++i) nodes[offset[t] + i - 1] = renumber(local[i]);
     }
     std::vector<SubtreeNodes>().swap(subtrees_);
-    if (!keep_) release(subtree_nodes_);
+    release(subtree_nodes_);
   }
 
   std::vector<SubtreeNodes> subtrees_;
   std::atomic<size_t> subtree_used_{0};  // entries of subtree_nodes_ handed out
 #endif
 
-  // Copies the tree out: its nodes as built into host memory of the workspace, then in
-  // breadth-first order into the tree returned (as built, params.breadth_first: straight
-  // into the tree returned). Without a context each working buffer is freed as soon as it
-  // is done with, so that the finishing step does not raise the build's peak memory; a
-  // context's keep theirs for the next build, so that only the tree returned is fresh memory.
+  // Copies the tree out: the nodes in breadth-first order into the tree returned, from where
+  // gather_nodes put them (as built, params.breadth_first: straight into the tree returned).
+  // Each working buffer goes back to the pool as soon as it is done with, so that the
+  // finishing step takes the same memory and does not raise the build's peak.
   Bvh finish() {
-    if (!keep_)
-      release(boxes_[0], boxes_[1], ids_[0], ids_[1], cluster_of_, segments_, next_segments_, segment_offsets_,
-              pieces_, piece_counters_, counters_scanned_, reps_, sums_, counts_, bounds_, cluster_begin_,
-              cluster_segment_, child_counts_, child_offsets_);
+    release(boxes_[0], boxes_[1], ids_[0], ids_[1], cluster_of_, segments_, next_segments_, segment_offsets_,
+            pieces_, piece_counters_, counters_scanned_, reps_, sums_, counts_, bounds_, cluster_begin_,
+            cluster_segment_, child_counts_, child_offsets_);
     size_t total = node_count_;
 #if KMBVH_CPU_SUBTREES
     std::vector<uint32_t> offset;
     total = place_subtrees(offset);
 #endif
-    // Breadth first, the nodes are gathered in the workspace and reordered into the tree;
-    // as built, they are gathered into the tree itself.
     Bvh bvh = output_tree();
-    std::vector<BvhNode>& built = params_.breadth_first ? ws_.built_nodes : bvh.nodes;
-    grow_on_huge_pages(built, total);  // the workspace's is kept at its largest: no zero fill when it fits
-    copy_to_host(ptr(nodes_), node_count_, built.data());
-    if (!keep_) release(nodes_);
+    BvhNode* built = gather_nodes(bvh, total);
 #if KMBVH_CPU_SUBTREES
-    append_subtrees(built.data(), offset);
+    append_subtrees(built, offset);
 #endif
     bvh.prim_indices.resize(n_);  // in the lent tree's memory, where there is one (output_tree)
     copy_to_host(ptr(final_ids_), n_, bvh.prim_indices.data());
-    if (!keep_) release(final_ids_);
+    release(final_ids_);
     if (info_) info_->forced_splits += read(forced_, 0);
-    if (params_.breadth_first) breadth_first_nodes(built.data(), total, ws_.order_scratch, bvh.nodes);
+    release(forced_);
+    if (params_.breadth_first) breadth_first_nodes(built, total, ws_.order_scratch, bvh.nodes);
+    release(nodes_);
     clock_.lap("finish");
     return bvh;
+  }
+
+  // Room for all `total` nodes, the level loop's first: breadth first, the level loop's own
+  // buffer on the CPU (host memory already: no copy, and no more memory), host memory of
+  // the workspace on the GPU; as built, the tree returned.
+  BvhNode* gather_nodes(Bvh& bvh, size_t total) {
+#if KMBVH_BACKEND_CPU
+    if (params_.breadth_first) {
+      grow_to(nodes_, total);
+      return ptr(nodes_);
+    }
+#endif
+    std::vector<BvhNode>& built = params_.breadth_first ? ws_.built_nodes : bvh.nodes;
+    grow_on_huge_pages(built, total);  // the workspace's is kept at its largest: no zero fill when it fits
+    copy_to_host(ptr(nodes_), node_count_, built.data());
+    return built.data();
   }
 
 
@@ -413,7 +432,6 @@ class KMeansLevels {
   BuildInfo* info_;
   PhaseClock clock_;
   KMeansWorkspace& ws_;
-  const bool keep_;
 
   int current_ = 0;  // which of the double buffers holds the level's primitives
   Buffer<Aabb>* const boxes_ = ws_.boxes;
@@ -447,13 +465,12 @@ class KMeansLevels {
 };
 
 template <ClusterMetric M>
-Bvh build_with_metric(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info, KMeansWorkspace& ws,
-                      bool keep) {
+Bvh build_with_metric(const PrimitiveSet& prims, const KMeansParams& params, BuildInfo* info, KMeansWorkspace& ws) {
   // Local arrays in the kernels are sized by the smallest bound that holds k.
-  if (params.k <= 8) return KMeansLevels<8, M>(prims, params, info, ws, keep).run();
-  if (params.k <= 16) return KMeansLevels<16, M>(prims, params, info, ws, keep).run();
-  if (params.k <= 32) return KMeansLevels<32, M>(prims, params, info, ws, keep).run();
-  return KMeansLevels<64, M>(prims, params, info, ws, keep).run();
+  if (params.k <= 8) return KMeansLevels<8, M>(prims, params, info, ws).run();
+  if (params.k <= 16) return KMeansLevels<16, M>(prims, params, info, ws).run();
+  if (params.k <= 32) return KMeansLevels<32, M>(prims, params, info, ws).run();
+  return KMeansLevels<64, M>(prims, params, info, ws).run();
 }
 
 // The build, in `context`'s workspace for this backend when there is one (`key`, one per
@@ -463,13 +480,13 @@ inline Bvh build(const PrimitiveSet& prims, const KMeansParams& params, BuildInf
   const uint32_t n = static_cast<uint32_t>(prims.size());
   if (n <= params.max_leaf_size) return Bvh::single_leaf(prims.bounds(), n);
   const CountBackendSteps counting(info ? &info->backend : nullptr);
-  KMeansWorkspace own;
+  KMeansWorkspace own(/*keep=*/false);
   KMeansWorkspace& ws = context ? context->workspace<KMeansWorkspace>(key) : own;
   const UsePool pool(ws.scratch);
   const UseContext current(context);
   if (params.metric == ClusterMetric::Means)
-    return build_with_metric<ClusterMetric::Means>(prims, params, info, ws, context != nullptr);
-  return build_with_metric<ClusterMetric::Medians>(prims, params, info, ws, context != nullptr);
+    return build_with_metric<ClusterMetric::Means>(prims, params, info, ws);
+  return build_with_metric<ClusterMetric::Medians>(prims, params, info, ws);
 }
 
 }  // namespace KMBVH_BACKEND_NAMESPACE
