@@ -21,10 +21,12 @@ void expect_same_layouts(const PrimitiveSet& prims, uint32_t m, const char* what
   using namespace cpu_backend;
   BinaryBuildParams params;
   params.max_leaf_size = m;
+  const InputBoxes boxes(prims.boxes);
   MortonRadixTree tree;
   CollapseState state(uint32_t(prims.size()));
   PhaseClock clock(nullptr);
-  build_morton_radix_tree(prims, tree, state, params, RadixTreeParts{/*parents=*/false, /*range_first=*/true}, clock);
+  build_morton_radix_tree(boxes, uint32_t(prims.size()), tree, state, params,
+                          RadixTreeParts{/*parents=*/false, /*range_first=*/true}, clock);
   for (const bool ranges : {true, false}) {
     const uint32_t* range_first = ranges ? ptr(tree.range_first) : nullptr;
     const Bvh pass = lay_out(tree.view(), state.view(), range_first);

@@ -193,21 +193,21 @@ TEST(Ploc, BlockedSearchPicksTheSameNeighbours) {
 // the CPU runs it (ploc_iteration_cpu: one parallel region), from the leaves' boxes in their
 // order to one cluster.
 struct PlocRun {
-  std::vector<uint32_t> left, right, parent, clusters, next_clusters, nearest;
-  std::vector<Aabb> box;
+  std::vector<uint32_t> left, right, parent, clusters, next_clusters, nearest, order;
+  std::vector<Aabb> box;  // the inner nodes'
   std::vector<float> columns;
   uint32_t iterations = 0, paired = 0;
 
   PlocRun(const std::vector<Aabb>& leaves, bool fused) {
     const auto n = uint32_t(leaves.size());
-    left.resize(n - 1), right.resize(n - 1), parent.resize(2 * n - 1), box.resize(2 * n - 1);
+    left.resize(n - 1), right.resize(n - 1), parent.resize(2 * n - 1), box.resize(n - 1), order.resize(n);
     clusters.resize(n), next_clusters.resize(n), nearest.resize(n);
     columns.resize(6 * size_t(n));
     BinaryTreeView tree;
     tree.n = n, tree.left = left.data(), tree.right = right.data(), tree.parent = parent.data();
-    tree.box = box.data();
+    tree.inner_box = box.data(), tree.prim_box = leaves.data(), tree.order = order.data();
     const BoxColumns cluster_box{columns.data(), n};
-    for (uint32_t i = 0; i < n; ++i) box[i] = leaves[i], cluster_box.set(i, leaves[i]), clusters[i] = i;
+    for (uint32_t i = 0; i < n; ++i) order[i] = i, cluster_box.set(i, leaves[i]), clusters[i] = i;
     uint32_t count = n, next_inner = n;
     bool stalled = false;
     // Every third iteration's neighbours are paired by position too (as after a stall).
@@ -235,7 +235,7 @@ struct PlocRun {
         }
         merge.offsets = offsets.data();
         for (uint32_t i = 0; i < count; ++i) merge(i);
-        const GatherClusterBoxes gather{next_clusters.data(), box.data(), cluster_box};
+        const GatherClusterBoxes gather{next_clusters.data(), tree, cluster_box};
         for (uint32_t k = 0; k < total.kept; ++k) gather(k);
       }
       std::swap(clusters, next_clusters);

@@ -37,9 +37,10 @@ inline Bvh build_atrbvh(const PrimitiveSet& prims, const BinaryBuildParams& para
   const auto n = static_cast<uint32_t>(prims.size());
   if (n < 2) return Bvh::single_leaf(prims.bounds(), n);
   PhaseClock clock(info);
+  const InputBoxes boxes(prims.boxes);
   MortonRadixTree radix;
   CollapseState state(n);
-  build_morton_radix_tree(prims, radix, state, params, RadixTreeParts{}, clock);
+  build_morton_radix_tree(boxes, n, radix, state, params, RadixTreeParts{}, clock);
   release(radix.codes);
   return restructure_collapse_and_lay_out(radix.view(), state, params, info, clock);
 }

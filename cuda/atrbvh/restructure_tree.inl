@@ -70,7 +70,7 @@ inline void binary_tree_of(const Bvh& input, uint32_t n, MortonRadixTree& out) {
   out.right.assign(right.begin(), right.end());
   out.parent.assign(parent.begin(), parent.end());
   out.order.assign(order.begin(), order.end());
-  out.node_box.resize(2 * size_t(n) - 1);
+  out.inner_box.resize(n - 1);
 }
 
 inline Bvh restructure_treelets(const PrimitiveSet& prims, const Bvh& input, const BinaryBuildParams& params,
@@ -79,13 +79,14 @@ inline Bvh restructure_treelets(const PrimitiveSet& prims, const Bvh& input, con
   if (n < 2) return Bvh::single_leaf(prims.bounds(), n);
   if (input.empty()) throw std::invalid_argument("restructure_treelets: an empty tree for a set of primitives");
   PhaseClock clock(info);
+  const InputBoxes boxes(prims.boxes);
   MortonRadixTree binary;
   binary_tree_of(input, n, binary);
+  binary.prim_box = boxes.data();
   clock.lap("binary tree");
   const BinaryTreeView tree = binary.view();
   CollapseState state(n);
-  const InputBoxes boxes(prims.boxes);
-  collapse(tree, state, params.max_leaf_size, params.sah, /*refit=*/true, boxes.data());  // boxes, counts, costs
+  collapse(tree, state, params.max_leaf_size, params.sah, /*refit=*/true);  // boxes, counts, costs
   return restructure_collapse_and_lay_out(tree, state, params, info, clock);
 }
 

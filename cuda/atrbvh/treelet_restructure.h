@@ -44,8 +44,8 @@ struct RestructureTreelet {
     leaf[0] = left_of(root);
     leaf[1] = right_of(root);
     inner[0] = root;
-    box[0] = coherent_load(&tree.box[leaf[0]]);
-    box[1] = coherent_load(&tree.box[leaf[1]]);
+    box[0] = tree.coherent_box(leaf[0]);
+    box[1] = tree.coherent_box(leaf[1]);
     while (leaves < treelet_size) {
       int pick = -1;
       float largest = -1.0f;
@@ -59,8 +59,8 @@ struct RestructureTreelet {
       inner[inners++] = node;
       leaf[pick] = left_of(node);
       leaf[leaves] = right_of(node);
-      box[pick] = coherent_load(&tree.box[leaf[pick]]);
-      box[leaves] = coherent_load(&tree.box[leaf[leaves]]);
+      box[pick] = tree.coherent_box(leaf[pick]);
+      box[leaves] = tree.coherent_box(leaf[leaves]);
       ++leaves;
     }
     if (leaves < 3) return;  // two leaves have one topology only
@@ -91,7 +91,7 @@ struct RestructureTreelet {
       tree.right[tree.inner(self)] = b;
       tree.parent[a] = self;
       tree.parent[b] = self;
-      tree.box[self] = merges.box[m];
+      tree.set_box(self, merges.box[m]);
       nodes.count[self] = count[leaves + m];
       nodes.cost[self] = cost[leaves + m];
     }

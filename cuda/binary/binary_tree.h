@@ -3,13 +3,16 @@
 // laid out as a Bvh (emit_binary.h).
 //
 // Node ids: 0 .. n-1 are the leaves, in the builder's primitive order (leaf i holds
-// primitive order[i]); n .. 2n-2 are the inner nodes. `left`, `right` are indexed by inner
-// node id minus n; `parent` and per-node data by node id (the root's parent is kNoParent).
+// primitive order[i]); n .. 2n-2 are the inner nodes. `left`, `right` and `inner_box` are
+// indexed by inner node id minus n; `parent` and per-node data by node id (the root's parent
+// is kNoParent). A leaf's box is its primitive's, read from the build's input: not kept a
+// second time (24 bytes a primitive of the build's peak memory, issue #15).
 #pragma once
 
 #include <cstdint>
 
 #include "../core/aabb.h"
+#include "../core/atomics.h"
 
 namespace kmbvh {
 
@@ -21,11 +24,18 @@ struct BinaryTreeView {
   uint32_t* left = nullptr;
   uint32_t* right = nullptr;
   uint32_t* parent = nullptr;
-  Aabb* box = nullptr;   // per node
+  Aabb* inner_box = nullptr;        // per inner node
+  const Aabb* prim_box = nullptr;   // per primitive: the build's input boxes
   const uint32_t* order = nullptr;  // leaf i holds primitive order[i]
 
   KMBVH_HD bool is_leaf(uint32_t node) const { return node < n; }
   KMBVH_HD uint32_t inner(uint32_t node) const { return node - n; }
+  KMBVH_HD Aabb box(uint32_t node) const { return is_leaf(node) ? prim_box[order[node]] : inner_box[inner(node)]; }
+  // The same, for a node that another thread of a climb (climb.h) may have just set.
+  KMBVH_HD Aabb coherent_box(uint32_t node) const {
+    return is_leaf(node) ? prim_box[order[node]] : coherent_load(&inner_box[inner(node)]);
+  }
+  KMBVH_HD void set_box(uint32_t inner_node, const Aabb& b) const { inner_box[inner(inner_node)] = b; }
 };
 
 }  // namespace kmbvh

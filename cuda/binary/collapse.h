@@ -23,18 +23,20 @@ struct CollapseView {
   uint8_t* collapsed;  // 1: the node is a leaf of the final tree (every primitive leaf is)
 };
 
-// Leaf i: its primitive's box (when prim_boxes is set; else the box is there already),
-// one primitive, the cost of intersecting it.
+// Leaf i: one primitive, the cost of intersecting it.
 struct InitLeaves {
   BinaryTreeView tree;
   CollapseView out;
   SahCosts k;
-  const Aabb* prim_boxes;
 
   KMBVH_HD void operator()(uint32_t leaf) const {
-    if (prim_boxes) tree.box[leaf] = prim_boxes[tree.order[leaf]];
+#if !defined(__CUDA_ARCH__)
+    // Leaf boxes are a gather from the input's order (binary_tree.h): a CPU thread runs its
+    // leaves in order, and fetches a few ahead.
+    if (leaf + 16 < tree.n) __builtin_prefetch(&tree.prim_box[tree.order[leaf + 16]]);
+#endif
     out.count[leaf] = 1;
-    out.cost[leaf] = k.intersection * tree.box[leaf].surface_area();
+    out.cost[leaf] = k.intersection * tree.box(leaf).surface_area();
     out.collapsed[leaf] = 1;
   }
 };
@@ -52,10 +54,10 @@ struct CollapseNode {
     const uint32_t l = coherent_load(&tree.left[tree.inner(node)]), r = coherent_load(&tree.right[tree.inner(node)]);
     Aabb box;
     if (refit) {
-      box = join(coherent_load(&tree.box[l]), coherent_load(&tree.box[r]));
-      tree.box[node] = box;
+      box = join(tree.coherent_box(l), tree.coherent_box(r));
+      tree.set_box(node, box);
     } else {
-      box = tree.box[node];
+      box = tree.box(node);
     }
     const uint32_t count = coherent_load(&out.count[l]) + coherent_load(&out.count[r]);
     const float area = box.surface_area();

@@ -69,7 +69,7 @@ struct WriteLevel {
 
   KMBVH_HD void operator()(uint32_t q) const {
     const uint32_t node = frontier[q];
-    const Aabb box = tree.box[node];
+    const Aabb box = tree.box(node);
     if (!collapse.collapsed[node]) {
       const uint32_t first = next_base + offsets[q].children;
       nodes[level_base + q] = BvhNode::make_interior(box, first, 2);

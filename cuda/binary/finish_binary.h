@@ -25,14 +25,12 @@ struct CollapseState {
   CollapseView view() { return {ptr(count), ptr(cost), ptr(collapsed)}; }
 };
 
-// Costs and collapse flags for a tree whose topology is final. The leaves' boxes are set
-// from prim_boxes when given, else they must be set already; with refit, inner boxes are
-// computed on the way up, else they must be set too.
-inline void collapse(const BinaryTreeView& tree, CollapseState& state, uint32_t max_leaf_size, SahCosts k, bool refit,
-                     const Aabb* prim_boxes = nullptr) {
+// Costs and collapse flags for a tree whose topology is final. With refit, inner boxes are
+// computed on the way up, else they must be set already.
+inline void collapse(const BinaryTreeView& tree, CollapseState& state, uint32_t max_leaf_size, SahCosts k, bool refit) {
   Buffer<uint32_t> visits(tree.n - 1);
   thrust::fill(launch(), visits.begin(), visits.end(), 0u);
-  for_each_index(tree.n, InitLeaves{tree, state.view(), k, prim_boxes});
+  for_each_index(tree.n, InitLeaves{tree, state.view(), k});
   for_each_index(tree.n, climb_from_leaves(tree, ptr(visits), CollapseNode{tree, state.view(), k, max_leaf_size, refit}));
 }
 
@@ -77,14 +75,18 @@ inline Bvh lay_out(const BinaryTreeView& tree, CollapseView view, const uint32_t
     if (i + kAhead < end) {
       const uint32_t ahead = queue[i + kAhead];
       __builtin_prefetch(&view.collapsed[ahead]);
-      __builtin_prefetch(&tree.box[ahead]);
-      if (!tree.is_leaf(ahead)) {
+      if (tree.is_leaf(ahead)) {
+        __builtin_prefetch(&tree.order[ahead]);
+      } else {
+        __builtin_prefetch(&tree.inner_box[tree.inner(ahead)]);
         __builtin_prefetch(&tree.left[tree.inner(ahead)]);
         __builtin_prefetch(&tree.right[tree.inner(ahead)]);
       }
     }
+    if (i + kAhead / 2 < end && tree.is_leaf(queue[i + kAhead / 2]))  // a leaf's box: through its order
+      __builtin_prefetch(&tree.prim_box[tree.order[queue[i + kAhead / 2]]]);
     const uint32_t node = queue[i];
-    const Aabb box = tree.box[node];
+    const Aabb box = tree.box(node);
     if (!view.collapsed[node]) {
       nodes.push_back(BvhNode::make_interior(box, end, 2));
       queue[end] = tree.left[tree.inner(node)];

@@ -52,9 +52,10 @@ inline Bvh build_hlbvh(const PrimitiveSet& prims, const BinaryBuildParams& param
   const auto n = static_cast<uint32_t>(prims.size());
   if (n < 2) return Bvh::single_leaf(prims.bounds(), n);
   PhaseClock clock(info);
+  const InputBoxes boxes(prims.boxes);
   MortonRadixTree radix;
   CollapseState state(n);
-  build_morton_radix_tree(prims, radix, state, params, RadixTreeParts{true, true, true}, clock);
+  build_morton_radix_tree(boxes, n, radix, state, params, RadixTreeParts{true, true, true}, clock);
   BinaryTreeView tree = radix.view();
 
   // The groups of equal 15-bit prefix, their subtrees' roots, and the inner nodes above them.

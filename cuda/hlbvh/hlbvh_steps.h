@@ -53,7 +53,7 @@ struct DescribeCluster {
   KMBVH_HD void operator()(uint32_t c) const {
     const uint32_t first = cluster_first[c];
     const uint32_t last = c + 1 < cluster_count ? cluster_first[c + 1] - 1 : tree.n - 1;
-    clusters[c] = {tree.box[first], first, last - first + 1};
+    clusters[c] = {tree.box(first), first, last - first + 1};
   }
 };
 
@@ -79,7 +79,7 @@ struct FindClusterRoots {
     if (parent != kNoParent && in_one_cluster(tree.inner(parent))) return;
     Cluster& c = clusters[index[range_first[inner]] - 1];
     c.node = tree.n + inner;
-    c.box = tree.box[c.node];
+    c.box = tree.box(c.node);
   }
 };
 

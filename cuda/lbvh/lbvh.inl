@@ -32,7 +32,8 @@ struct MortonRadixTree {
   Buffer<unsigned long long> codes;
   Buffer<uint32_t> order, left, right, parent;  // parent: when asked for (RadixTreeParts)
   Buffer<uint32_t> range_first, range_last;     // per inner node, when asked for
-  Buffer<Aabb> node_box;
+  Buffer<Aabb> inner_box;
+  const Aabb* prim_box = nullptr;               // the build's input boxes (InputBoxes), the leaves'
   uint32_t root = 0;                            // node id, known once the tree is built
 
   BinaryTreeView view() {
@@ -42,27 +43,28 @@ struct MortonRadixTree {
     t.left = ptr(left);
     t.right = ptr(right);
     t.parent = parent.empty() ? nullptr : ptr(parent);
-    t.box = ptr(node_box);
+    t.inner_box = ptr(inner_box);
+    t.prim_box = prim_box;
     t.order = ptr(order);
     return t;
   }
 };
 
-// n >= 2.
-inline void build_morton_radix_tree(const PrimitiveSet& prims, MortonRadixTree& t, CollapseState& state,
+// n >= 2. `boxes` (the primitives' boxes as the backend reads them) must outlive the tree.
+inline void build_morton_radix_tree(const InputBoxes& boxes, uint32_t n, MortonRadixTree& t, CollapseState& state,
                                     const BinaryBuildParams& params, RadixTreeParts parts, PhaseClock& clock) {
-  t.n = static_cast<uint32_t>(prims.size());
-  const InputBoxes boxes(prims.boxes);
+  t.n = n;
+  t.prim_box = boxes.data();
   morton_order(boxes.data(), t.n, t.codes, t.order);
   clock.lap("morton");
   t.left.resize(t.n - 1);
   t.right.resize(t.n - 1);
   if (parts.parents) t.parent.resize(2 * t.n - 1);
-  t.node_box.resize(2 * t.n - 1);
+  t.inner_box.resize(t.n - 1);
   Buffer<uint32_t> other_end(t.n - 1), root(1);
   thrust::fill(launch(), other_end.begin(), other_end.end(), kNotYet);
   BinaryTreeView tree = t.view();
-  for_each_index(t.n, InitLeaves{tree, state.view(), params.sah, boxes.data()});
+  for_each_index(t.n, InitLeaves{tree, state.view(), params.sah});
   auto build = build_radix_tree(ptr(t.codes), tree, ptr(other_end), ptr(root),
                                 CollapseNode{tree, state.view(), params.sah, params.max_leaf_size, /*refit=*/true});
   if (parts.range_first) {
@@ -81,9 +83,11 @@ inline void build_morton_radix_tree(const PrimitiveSet& prims, MortonRadixTree& 
 inline Bvh build_lbvh(const PrimitiveSet& prims, const BinaryBuildParams& params, BuildInfo* info) {
   if (prims.size() < 2) return Bvh::single_leaf(prims.bounds(), uint32_t(prims.size()));
   PhaseClock clock(info);
+  const InputBoxes boxes(prims.boxes);
   MortonRadixTree tree;
   CollapseState state(uint32_t(prims.size()));
-  build_morton_radix_tree(prims, tree, state, params, RadixTreeParts{/*parents=*/false, /*range_first=*/true}, clock);
+  build_morton_radix_tree(boxes, uint32_t(prims.size()), tree, state, params,
+                          RadixTreeParts{/*parents=*/false, /*range_first=*/true}, clock);
   release(tree.codes);
   Bvh bvh = lay_out(tree.view(), state.view(), ptr(tree.range_first));
   clock.lap("layout");

@@ -62,7 +62,7 @@ inline MergeCounts ploc_iteration_cpu(uint32_t count, uint32_t radius, bool pair
     // Once every share has merged (the columns are read until then), each gathers the boxes
     // of the survivors it wrote.
 #pragma omp barrier
-    const GatherClusterBoxes gather{merge.next_clusters, merge.tree.box, box};
+    const GatherClusterBoxes gather{merge.next_clusters, merge.tree, box};
     for (uint32_t k = first_kept; k < before.kept; ++k) gather(k);
   }
   return shares[0];

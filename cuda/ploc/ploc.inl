@@ -18,17 +18,12 @@
 namespace kmbvh {
 namespace KMBVH_BACKEND_NAMESPACE {
 
-// Leaf i (position i in Morton order): its primitive's box, in the tree and in the columns
-// the first iteration searches.
+// Leaf i (position i in Morton order): its primitive's box, into the columns the first
+// iteration searches.
 struct SetLeafBoxes {
   BinaryTreeView tree;
-  const Aabb* prim_boxes;
   BoxColumns columns;
-  KMBVH_HD void operator()(uint32_t i) const {
-    const Aabb box = prim_boxes[tree.order[i]];
-    tree.box[i] = box;
-    columns.set(i, box);
-  }
+  KMBVH_HD void operator()(uint32_t i) const { columns.set(i, tree.box(i)); }
 };
 
 // The nearest-neighbour search, sized by the radius (its window is a local array).
@@ -57,7 +52,7 @@ inline MergeCounts ploc_iteration(uint32_t count, uint32_t radius, bool paired, 
   const MergeCounts total = AddMergeCounts{}(read(offsets, count - 1), read(counts, count - 1));
   merge.offsets = ptr(offsets);
   for_each_index(count, merge);
-  for_each_index(total.kept, GatherClusterBoxes{merge.next_clusters, merge.tree.box, box});
+  for_each_index(total.kept, GatherClusterBoxes{merge.next_clusters, merge.tree, box});
   return total;
 }
 
@@ -73,19 +68,20 @@ inline Bvh build_ploc(const PrimitiveSet& prims, const BinaryBuildParams& params
   clock.lap("morton");
 
   Buffer<uint32_t> left(n - 1), right(n - 1), parent(2 * n - 1);
-  Buffer<Aabb> node_box(2 * n - 1);
+  Buffer<Aabb> inner_box(n - 1);
   BinaryTreeView tree;
   tree.n = n;
   tree.left = ptr(left);
   tree.right = ptr(right);
   tree.parent = ptr(parent);
-  tree.box = ptr(node_box);
+  tree.inner_box = ptr(inner_box);
+  tree.prim_box = boxes.data();
   tree.order = ptr(order);
 
   Buffer<uint32_t> clusters(n), next_clusters(n), nearest(n);
   Buffer<float> box_columns(6 * size_t(n));
   const BoxColumns cluster_box{ptr(box_columns), n};
-  for_each_index(n, SetLeafBoxes{tree, boxes.data(), cluster_box});
+  for_each_index(n, SetLeafBoxes{tree, cluster_box});
 #if KMBVH_BACKEND_CPU
   // An iteration in one parallel region (iteration_cpu.h), with no counts to scan.
   const bool fused = params.ploc_radius <= kPlocCpuMaxRadius;

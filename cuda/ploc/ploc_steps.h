@@ -191,7 +191,7 @@ struct MergeAndCompact {
       tree.right[tree.inner(node)] = b;
       tree.parent[a] = node;
       tree.parent[b] = node;
-      tree.box[node] = join(cluster_box.get(i), cluster_box.get(j));
+      tree.set_box(node, join(cluster_box.get(i), cluster_box.get(j)));
     }
     next_clusters[before.kept] = node;
   }
@@ -200,10 +200,10 @@ struct MergeAndCompact {
 // Position k of the next iteration: its cluster's box, into the columns the search reads.
 struct GatherClusterBoxes {
   const uint32_t* clusters;
-  const Aabb* node_box;
+  BinaryTreeView tree;
   BoxColumns columns;
 
-  KMBVH_HD void operator()(uint32_t k) const { columns.set(k, node_box[clusters[k]]); }
+  KMBVH_HD void operator()(uint32_t k) const { columns.set(k, tree.box(clusters[k])); }
 };
 
 }  // namespace kmbvh
