@@ -16,6 +16,12 @@ namespace kmbvh {
 // all but its ends).
 void advise_huge_pages(const void* p, size_t bytes);
 
+// Gives the pages malloc holds free back to the system (glibc's malloc_trim; nothing
+// elsewhere). A build without a context frees tens of megabytes, and glibc keeps what falls
+// below its mmap threshold (which it raises to the largest block freed, up to 32 MiB) in
+// its heap, resident.
+void return_free_memory();
+
 // Faults in the whole 4 KiB pages inside [p, p + bytes) for writing, in one system call
 // (MADV_POPULATE_WRITE, Linux 5.14): the kernel allocates and zeroes them as the first
 // writes would, without a fault for each. On this project's virtual machines a fault costs

@@ -9,6 +9,7 @@
 #include "adapters/builder_registry.h"
 #include "adapters/out/cpu_isa.h"
 #include "cuda/metrics/sah.h"
+#include "cuda/core/huge_pages.h"
 #include "cuda/core/parallel_errors.h"
 #include "cuda/core/refit.h"
 #include "plugin/plugin_config.h"
@@ -130,6 +131,7 @@ SceneAccel::SceneAccel(CommitMeshes input, std::vector<GeometryFilters> filters,
       base.config = config;
     } else {
       bvh = run_builder(config, prims, &info, context);
+      if (!context) return_free_memory();  // what the build freed, before the layout peaks
     }
     const Bvh& traced = refittable ? refit_base_->traced() : bvh;
     report.allocations = info.backend.allocations;
