@@ -27,8 +27,8 @@ uint64_t allocations_during(const std::function<void()>& steps) {
   return counters.allocations;
 }
 
-// Writes the whole range, so that a range handed out twice at once shows up under the
-// address sanitizer as well as in the checks.
+// Writes the whole range, so that a range running past its segment shows up under the
+// address sanitizer.
 char* take(MemoryPool& pool, size_t bytes) {
   char* p = pool.allocate(std::ptrdiff_t(bytes));
   std::fill(p, p + bytes, char(1));
