@@ -56,7 +56,7 @@ namespace kmbvh {
 namespace KMBVH_BACKEND_NAMESPACE {
 
 // The level loop's memory, kept in a BuildContext from one build to the next. Every buffer
-// takes its memory from the workspace's pool, which keeps it: a build gives each buffer
+// takes its memory from the workspace's pool, which keeps it; a build gives each buffer
 // back as soon as it is done with it, so that the next (the finishing step's) can take
 // the same memory, and a build asking for what the last one asked allocates nothing
 // (memory_pool.h).
@@ -85,9 +85,11 @@ struct KMeansWorkspace : BuildContext::Workspace {
   std::vector<BvhNode> built_nodes;
   std::vector<uint32_t> order_scratch;
 
-  // keep = false: a build's own workspace, whose buffers go back to the system as soon as
-  // they are done with (the finishing step's host memory then takes their pages).
-  explicit KMeansWorkspace(bool keep = true) : scratch(keep) {
+  // kept = false: a build's own workspace (no context). Its buffers then come from the
+  // system's allocator, which takes their pages back when the finishing step frees them,
+  // and its pool holds only Thrust's temporaries, for the build's length.
+  explicit KMeansWorkspace(bool kept = true) {
+    if (!kept) return;
     take_from_scratch(boxes[0], boxes[1], ids[0], ids[1], final_ids, cluster_of, segments, next_segments,
                       segment_offsets, pieces, piece_counters, counters_scanned, reps, sums, counts, bounds,
                       cluster_begin, cluster_segment, child_counts, child_offsets, forced, nodes, subtree_nodes);
@@ -480,7 +482,7 @@ inline Bvh build(const PrimitiveSet& prims, const KMeansParams& params, BuildInf
   const uint32_t n = static_cast<uint32_t>(prims.size());
   if (n <= params.max_leaf_size) return Bvh::single_leaf(prims.bounds(), n);
   const CountBackendSteps counting(info ? &info->backend : nullptr);
-  KMeansWorkspace own(/*keep=*/false);
+  KMeansWorkspace own(/*kept=*/false);
   KMeansWorkspace& ws = context ? context->workspace<KMeansWorkspace>(key) : own;
   const UsePool pool(ws.scratch);
   const UseContext current(context);
