@@ -7,6 +7,7 @@
 #include "cuda/core/memory_pool.h"
 
 #include <gtest/gtest.h>
+#include <sys/mman.h>
 
 #include <algorithm>
 #include <cstdint>
@@ -107,6 +108,23 @@ TEST(MemoryPool, ASmallerBuildFitsWhatALargerOneLeft) {
   EXPECT_GT(allocations_during([&] { build(100000); }), 0u);
   EXPECT_EQ(allocations_during([&] { build(60000); }), 0u);
   EXPECT_EQ(allocations_during([&] { build(100000); }), 0u);
+}
+
+// On the CPU a buffer of a megabyte or more goes into memory the build has touched before
+// memory it never has, where both hold it, even where the untouched range is the shorter.
+TEST(MemoryPool, ALargeBufferTakesTouchedMemoryBeforeUntouched) {
+  MemoryPool pool;
+  pool.begin_build();
+  char* touched = take(pool, 6 * kMiB);
+  char* untouched = pool.allocate(std::ptrdiff_t(5 * kMiB));
+  // Its pages out of memory, as fresh ones are (malloc may have handed out a reused block).
+  const uintptr_t page = 4096, first = (reinterpret_cast<uintptr_t>(untouched) + page - 1) & ~(page - 1);
+  ASSERT_EQ(madvise(reinterpret_cast<void*>(first), 4 * kMiB, MADV_DONTNEED), 0);
+  ASSERT_TRUE(pages_resident(touched, 4 * kMiB));
+  ASSERT_FALSE(pages_resident(untouched, 4 * kMiB));
+  pool.deallocate(touched, 6 * kMiB);
+  pool.deallocate(untouched, 5 * kMiB);
+  EXPECT_EQ(pool.allocate(std::ptrdiff_t(4 * kMiB)), touched);
 }
 
 TEST(MemoryPool, APoolThatKeepsNothingFreesEachBuffer) {

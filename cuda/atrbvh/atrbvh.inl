@@ -40,9 +40,11 @@ inline Bvh build_atrbvh(const PrimitiveSet& prims, const BinaryBuildParams& para
   const InputBoxes boxes(prims.boxes);
   MortonRadixTree radix;
   CollapseState state(n);
-  build_morton_radix_tree(boxes, n, radix, state, params, RadixTreeParts{}, clock);
+  build_morton_radix_tree(boxes, n, radix, state, params, RadixTreeParts{/*parents=*/false}, clock);
   release(radix.codes);
-  return restructure_collapse_and_lay_out(radix.view(), state, params, info, clock);
+  BinaryTreeView tree = radix.view();
+  set_parents(tree, radix.parent);  // in the Morton codes' memory: 8 bytes a primitive off the peak
+  return restructure_collapse_and_lay_out(tree, state, params, info, clock);
 }
 
 }  // namespace KMBVH_BACKEND_NAMESPACE

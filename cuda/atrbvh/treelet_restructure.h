@@ -18,7 +18,7 @@ constexpr uint32_t kMaxTreeletLeaves = 16;
 
 struct RestructureTreelet {
   BinaryTreeView tree;
-  CollapseView nodes;  // count and cost per node, kept current as the climb goes
+  CollapseView nodes;  // count and cost per inner node, kept current as the climb goes
   SahCosts k;
   uint32_t max_leaf_size;
   uint32_t treelet_size;
@@ -69,8 +69,8 @@ struct RestructureTreelet {
     float cost[2 * kMaxTreeletLeaves];
     uint32_t count[2 * kMaxTreeletLeaves];
     for (uint32_t x = 0; x < leaves; ++x) {
-      weight[x] = count[x] = coherent_load(&nodes.count[leaf[x]]);
-      cost[x] = coherent_load(&nodes.cost[leaf[x]]);
+      weight[x] = count[x] = nodes.coherent_primitives(tree, leaf[x]);
+      cost[x] = nodes.coherent_cost(tree, leaf[x], box[x], k);
     }
     TreeletMerges<kMaxTreeletLeaves> merges;
     agglomerate(box, weight, leaves, merges);
@@ -81,7 +81,7 @@ struct RestructureTreelet {
       cost[self] = node_cost(merges.box[m], count[self], cost[a] + cost[b]);
     }
     const uint32_t top = leaves + leaves - 2;
-    if (!(cost[top] < nodes.cost[root])) return;
+    if (!(cost[top] < nodes.cost[tree.inner(root)])) return;
 
     // Keep it: the last merge is the root; the other merges reuse the treelet's inner nodes.
     auto node_of = [&](uint32_t ref) { return ref < leaves ? leaf[ref] : (ref == top ? root : inner[1 + ref - leaves]); };
@@ -92,8 +92,8 @@ struct RestructureTreelet {
       tree.parent[a] = self;
       tree.parent[b] = self;
       tree.set_box(self, merges.box[m]);
-      nodes.count[self] = count[leaves + m];
-      nodes.cost[self] = cost[leaves + m];
+      nodes.count[tree.inner(self)] = count[leaves + m];
+      nodes.cost[tree.inner(self)] = cost[leaves + m];
     }
   }
 };

@@ -3,9 +3,9 @@
 // laid out as a Bvh (emit_binary.h).
 //
 // Node ids: 0 .. n-1 are the leaves, in the builder's primitive order (leaf i holds
-// primitive order[i]); n .. 2n-2 are the inner nodes. `left`, `right` and `inner_box` are
-// indexed by inner node id minus n; `parent` and per-node data by node id (the root's parent
-// is kNoParent). A leaf's box is its primitive's, read from the build's input: not kept a
+// primitive order[i]); n .. 2n-2 are the inner nodes. `left`, `right`, `inner_box` and the
+// collapse's results (collapse.h) are indexed by inner node id minus n; `parent` by node id
+// (the root's parent is kNoParent). A leaf's box is its primitive's, read from the build's input: not kept a
 // second time (24 bytes a primitive of the build's peak memory, issue #15).
 #pragma once
 
@@ -36,6 +36,17 @@ struct BinaryTreeView {
     return is_leaf(node) ? prim_box[order[node]] : coherent_load(&inner_box[inner(node)]);
   }
   KMBVH_HD void set_box(uint32_t inner_node, const Aabb& b) const { inner_box[inner(inner_node)] = b; }
+};
+
+// Inner node i's children told their parent (set_parents in finish_binary.h), for a tree whose
+// builder made its topology without them: the parents are only read by the climbs after it
+// (climb.h), so they are made then, in memory the builder's working buffers have left.
+struct SetParents {
+  BinaryTreeView tree;
+  KMBVH_HD void operator()(uint32_t i) const {
+    tree.parent[tree.left[i]] = tree.n + i;
+    tree.parent[tree.right[i]] = tree.n + i;
+  }
 };
 
 }  // namespace kmbvh

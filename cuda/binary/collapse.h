@@ -16,28 +16,28 @@ struct SahCosts {
   float intersection = 2.0f;
 };
 
-// Per-node results of the pass, indexed by node id.
+// The pass's results per inner node, indexed by inner node id minus n (as left and right).
+// A primitive's leaf has one primitive, costs k_I times its box's area and is a leaf of the
+// final tree: implied, not stored (9 bytes a primitive off the peak of every binary
+// builder that holds them while it builds, issue #15).
 struct CollapseView {
   uint32_t* count;     // primitives under the node
   float* cost;         // SAH cost (not normalised by the root's area)
-  uint8_t* collapsed;  // 1: the node is a leaf of the final tree (every primitive leaf is)
-};
+  uint8_t* collapsed;  // 1: the node is a leaf of the final tree
 
-// Leaf i: one primitive, the cost of intersecting it.
-struct InitLeaves {
-  BinaryTreeView tree;
-  CollapseView out;
-  SahCosts k;
-
-  KMBVH_HD void operator()(uint32_t leaf) const {
-#if !defined(__CUDA_ARCH__)
-    // Leaf boxes are a gather from the input's order (binary_tree.h): a CPU thread runs its
-    // leaves in order, and fetches a few ahead.
-    if (leaf + 16 < tree.n) __builtin_prefetch(&tree.prim_box[tree.order[leaf + 16]]);
-#endif
-    out.count[leaf] = 1;
-    out.cost[leaf] = k.intersection * tree.box(leaf).surface_area();
-    out.collapsed[leaf] = 1;
+  KMBVH_HD bool final_leaf(const BinaryTreeView& tree, uint32_t node) const {
+    return tree.is_leaf(node) || collapsed[tree.inner(node)] != 0;
+  }
+  KMBVH_HD uint32_t primitives(const BinaryTreeView& tree, uint32_t node) const {
+    return tree.is_leaf(node) ? 1u : count[tree.inner(node)];
+  }
+  // The same, for a node another thread of a climb (climb.h) may have just set.
+  KMBVH_HD uint32_t coherent_primitives(const BinaryTreeView& tree, uint32_t node) const {
+    return tree.is_leaf(node) ? 1u : coherent_load(&count[tree.inner(node)]);
+  }
+  // `box` is the node's.
+  KMBVH_HD float coherent_cost(const BinaryTreeView& tree, uint32_t node, const Aabb& box, SahCosts k) const {
+    return tree.is_leaf(node) ? k.intersection * box.surface_area() : coherent_load(&cost[tree.inner(node)]);
   }
 };
 
@@ -52,21 +52,25 @@ struct CollapseNode {
 
   KMBVH_HD void operator()(uint32_t node) const {
     const uint32_t l = coherent_load(&tree.left[tree.inner(node)]), r = coherent_load(&tree.right[tree.inner(node)]);
+    // A child's box is read where its cost needs it (a primitive's) or the refit does.
+    const Aabb left_box = refit || tree.is_leaf(l) ? tree.coherent_box(l) : Aabb();
+    const Aabb right_box = refit || tree.is_leaf(r) ? tree.coherent_box(r) : Aabb();
     Aabb box;
     if (refit) {
-      box = join(tree.coherent_box(l), tree.coherent_box(r));
+      box = join(left_box, right_box);
       tree.set_box(node, box);
     } else {
       box = tree.box(node);
     }
-    const uint32_t count = coherent_load(&out.count[l]) + coherent_load(&out.count[r]);
+    const uint32_t count = out.coherent_primitives(tree, l) + out.coherent_primitives(tree, r);
     const float area = box.surface_area();
-    const float split = k.traversal * area + coherent_load(&out.cost[l]) + coherent_load(&out.cost[r]);
+    const float split =
+        k.traversal * area + out.coherent_cost(tree, l, left_box, k) + out.coherent_cost(tree, r, right_box, k);
     const float as_leaf = k.intersection * float(count) * area;
     const bool collapse = count <= max_leaf_size && as_leaf <= split;
-    out.count[node] = count;
-    out.cost[node] = collapse ? as_leaf : split;
-    out.collapsed[node] = collapse ? 1 : 0;
+    out.count[tree.inner(node)] = count;
+    out.cost[tree.inner(node)] = collapse ? as_leaf : split;
+    out.collapsed[tree.inner(node)] = collapse ? 1 : 0;
   }
 };
 

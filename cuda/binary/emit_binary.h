@@ -23,13 +23,14 @@ struct AddLevelCounts {
 };
 
 struct CountLevel {
+  BinaryTreeView tree;
   const uint32_t* frontier;
   CollapseView collapse;
   LevelCounts* out;
 
   KMBVH_HD void operator()(uint32_t q) const {
     const uint32_t node = frontier[q];
-    out[q] = collapse.collapsed[node] ? LevelCounts{0, collapse.count[node]} : LevelCounts{2, 0};
+    out[q] = collapse.final_leaf(tree, node) ? LevelCounts{0, collapse.primitives(tree, node)} : LevelCounts{2, 0};
   }
 };
 
@@ -70,7 +71,7 @@ struct WriteLevel {
   KMBVH_HD void operator()(uint32_t q) const {
     const uint32_t node = frontier[q];
     const Aabb box = tree.box(node);
-    if (!collapse.collapsed[node]) {
+    if (!collapse.final_leaf(tree, node)) {
       const uint32_t first = next_base + offsets[q].children;
       nodes[level_base + q] = BvhNode::make_interior(box, first, 2);
       next_frontier[offsets[q].children] = tree.left[tree.inner(node)];
@@ -79,7 +80,7 @@ struct WriteLevel {
     }
     if (range_first) {
       const uint32_t first = tree.is_leaf(node) ? node : range_first[tree.inner(node)];
-      nodes[level_base + q] = BvhNode::make_leaf(box, first, collapse.count[node]);
+      nodes[level_base + q] = BvhNode::make_leaf(box, first, collapse.primitives(tree, node));
       return;
     }
     const uint32_t first = prim_base + offsets[q].prims;

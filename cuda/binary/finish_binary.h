@@ -15,22 +15,29 @@
 namespace kmbvh {
 namespace KMBVH_BACKEND_NAMESPACE {
 
-// Per-node counts, costs and collapse flags of a binary tree of n leaves.
+// Counts, costs and collapse flags of the inner nodes of a binary tree of n leaves.
 struct CollapseState {
   Buffer<uint32_t> count;
   Buffer<float> cost;
   Buffer<uint8_t> collapsed;
 
-  explicit CollapseState(uint32_t n) : count(2 * n - 1), cost(2 * n - 1), collapsed(2 * n - 1) {}
+  explicit CollapseState(uint32_t n) : count(n - 1), cost(n - 1), collapsed(n - 1) {}
   CollapseView view() { return {ptr(count), ptr(cost), ptr(collapsed)}; }
 };
+
+// Every node's parent into `parent` (2n - 1 entries), which the tree then points at.
+inline void set_parents(BinaryTreeView& tree, Buffer<uint32_t>& parent) {
+  parent.resize(2 * size_t(tree.n) - 1);
+  tree.parent = ptr(parent);
+  for_each_index(tree.n - 1, SetParents{tree});
+  write(parent, tree.root, kNoParent);
+}
 
 // Costs and collapse flags for a tree whose topology is final. With refit, inner boxes are
 // computed on the way up, else they must be set already.
 inline void collapse(const BinaryTreeView& tree, CollapseState& state, uint32_t max_leaf_size, SahCosts k, bool refit) {
   Buffer<uint32_t> visits(tree.n - 1);
   thrust::fill(launch(), visits.begin(), visits.end(), 0u);
-  for_each_index(tree.n, InitLeaves{tree, state.view(), k});
   for_each_index(tree.n, climb_from_leaves(tree, ptr(visits), CollapseNode{tree, state.view(), k, max_leaf_size, refit}));
 }
 
@@ -74,10 +81,10 @@ inline Bvh lay_out(const BinaryTreeView& tree, CollapseView view, const uint32_t
   for (uint32_t i = 0; i < end; ++i) {
     if (i + kAhead < end) {
       const uint32_t ahead = queue[i + kAhead];
-      __builtin_prefetch(&view.collapsed[ahead]);
       if (tree.is_leaf(ahead)) {
         __builtin_prefetch(&tree.order[ahead]);
       } else {
+        __builtin_prefetch(&view.collapsed[tree.inner(ahead)]);
         __builtin_prefetch(&tree.inner_box[tree.inner(ahead)]);
         __builtin_prefetch(&tree.left[tree.inner(ahead)]);
         __builtin_prefetch(&tree.right[tree.inner(ahead)]);
@@ -87,7 +94,7 @@ inline Bvh lay_out(const BinaryTreeView& tree, CollapseView view, const uint32_t
       __builtin_prefetch(&tree.prim_box[tree.order[queue[i + kAhead / 2]]]);
     const uint32_t node = queue[i];
     const Aabb box = tree.box(node);
-    if (!view.collapsed[node]) {
+    if (!view.final_leaf(tree, node)) {
       nodes.push_back(BvhNode::make_interior(box, end, 2));
       queue[end] = tree.left[tree.inner(node)];
       queue[end + 1] = tree.right[tree.inner(node)];
@@ -96,7 +103,7 @@ inline Bvh lay_out(const BinaryTreeView& tree, CollapseView view, const uint32_t
     }
     if (range_first) {
       const uint32_t first = tree.is_leaf(node) ? node : range_first[tree.inner(node)];
-      nodes.push_back(BvhNode::make_leaf(box, first, view.count[node]));
+      nodes.push_back(BvhNode::make_leaf(box, first, view.primitives(tree, node)));
       continue;
     }
     const uint32_t first = prims;
@@ -125,7 +132,7 @@ inline Bvh lay_out(const BinaryTreeView& tree, CollapseView view, const uint32_t
   while (level > 0) {
     grow_to(counts, level);
     grow_to(offsets, level);
-    for_each_index(level, CountLevel{ptr(frontier), view, ptr(counts)});
+    for_each_index(level, CountLevel{tree, ptr(frontier), view, ptr(counts)});
     thrust::exclusive_scan(launch(), counts.begin(), counts.begin() + level, offsets.begin(), LevelCounts{},
                            AddLevelCounts{});
     const LevelCounts total = AddLevelCounts{}(read(offsets, level - 1), read(counts, level - 1));

@@ -30,6 +30,11 @@ void return_free_memory();
 // whole; where the kernel cannot, the pages fault as before.
 void populate_pages(const void* p, size_t bytes);
 
+// Whether every whole 4 KiB page inside [p, p + bytes) is in memory (mincore): memory that
+// a build's pool has handed out and had back, against memory it has held but never touched
+// (a segment's rounded-up tail). False where it cannot tell.
+bool pages_resident(const void* p, size_t bytes);
+
 // v.reserve(n), with the new storage advised, and populated, before anything is written to
 // it: for arrays that are then written up to n.
 template <typename T>

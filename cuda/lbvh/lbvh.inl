@@ -64,7 +64,6 @@ inline void build_morton_radix_tree(const InputBoxes& boxes, uint32_t n, MortonR
   Buffer<uint32_t> other_end(t.n - 1), root(1);
   thrust::fill(launch(), other_end.begin(), other_end.end(), kNotYet);
   BinaryTreeView tree = t.view();
-  for_each_index(t.n, InitLeaves{tree, state.view(), params.sah});
   auto build = build_radix_tree(ptr(t.codes), tree, ptr(other_end), ptr(root),
                                 CollapseNode{tree, state.view(), params.sah, params.max_leaf_size, /*refit=*/true});
   if (parts.range_first) {

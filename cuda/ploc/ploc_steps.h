@@ -161,7 +161,7 @@ struct CountMerges {
   KMBVH_HD void operator()(uint32_t i) const { out[i] = merge_counts(nearest, i); }
 };
 
-// The lower position of a mutual pair makes the new inner node (its children, parents and
+// The lower position of a mutual pair makes the new inner node (its children and
 // box) and keeps it; the higher one drops out. Survivors' ids are written to their
 // compacted positions; their boxes, which tree.box holds for every cluster, are gathered
 // into the columns afterwards (GatherClusterBoxes), so the columns the search reads are
@@ -189,8 +189,6 @@ struct MergeAndCompact {
       node = first_inner + before.merges;
       tree.left[tree.inner(node)] = a;
       tree.right[tree.inner(node)] = b;
-      tree.parent[a] = node;
-      tree.parent[b] = node;
       tree.set_box(node, join(cluster_box.get(i), cluster_box.get(j)));
     }
     next_clusters[before.kept] = node;
