@@ -50,8 +50,8 @@ inline void free_fresh(char* p) { thrust::device_free(thrust::device_pointer_cas
 // 3. a fresh segment, its length rounded up to a quarter of its power of two, so that a
 //    slightly longer buffer (a level of another size) still fits it next time.
 // Ranges given back join their free neighbours in the same segment. So buffers whose lives
-// do not overlap share memory whatever their sizes (PLOC's Morton codes, then its child
-// ids; its clustering's buffers, then its collapse state), as they do under malloc: a
+// do not overlap share memory whatever their sizes (LBVH's Morton codes, then its layout's
+// queue; PLOC's clustering's columns, then its collapse state), as they do under malloc: a
 // first build in a context touches little more memory than one without. Step 1 is what
 // keeps that safe for a rebuild: best fit alone can hand a range to an earlier request
 // than the last time and leave a later one without.

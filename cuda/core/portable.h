@@ -252,18 +252,22 @@ inline Aabb bounds_of(Buffer<Aabb>& boxes, size_t n) {
   return thrust::reduce(launch_and_read(), boxes.begin(), boxes.begin() + n, Aabb::empty(), JoinBoxes{});
 }
 
-// Sorts (key, value) pairs by key, stably. The GPU uses Thrust (CUB's radix sort); the CPU
-// its own radix sort (radix_sort_cpu.h), as Thrust's OpenMP sort is comparison-based.
-inline void sort_pairs(Buffer<unsigned long long>& keys, Buffer<uint32_t>& values, size_t n, int key_bits) {
+// Sorts (key, value) pairs by key, stably. The GPU uses Thrust (CUB's radix sort, its
+// scratch from the build's pool); the CPU its own radix sort (radix_sort_cpu.h), as Thrust's
+// OpenMP sort is comparison-based, in `scratch` where the caller gives it (room for n keys,
+// then n values: 12 bytes a pair) and in buffers of its own where not.
+inline void sort_pairs(unsigned long long* keys, uint32_t* values, size_t n, int key_bits, void* scratch = nullptr) {
 #if KMBVH_BACKEND_CPU
   count_launch();
-  Buffer<unsigned long long> key_scratch(n);
-  Buffer<uint32_t> value_scratch(n);
-  radix_sort_pairs(reinterpret_cast<uint64_t*>(ptr(keys)), ptr(values), n, key_bits,
-                   reinterpret_cast<uint64_t*>(ptr(key_scratch)), ptr(value_scratch));
+  Buffer<unsigned long long> key_scratch(scratch ? 0 : n);
+  Buffer<uint32_t> value_scratch(scratch ? 0 : n);
+  uint64_t* const key_room = scratch ? static_cast<uint64_t*>(scratch) : reinterpret_cast<uint64_t*>(ptr(key_scratch));
+  uint32_t* const value_room = scratch ? reinterpret_cast<uint32_t*>(key_room + n) : ptr(value_scratch);
+  radix_sort_pairs(reinterpret_cast<uint64_t*>(keys), values, n, key_bits, key_room, value_room);
 #else
   (void)key_bits;
-  thrust::stable_sort_by_key(launch(), keys.begin(), keys.begin() + n, values.begin());
+  (void)scratch;
+  thrust::stable_sort_by_key(launch(), keys, keys + n, values);
 #endif
 }
 

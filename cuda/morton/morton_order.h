@@ -10,13 +10,19 @@
 namespace kmbvh {
 namespace KMBVH_BACKEND_NAMESPACE {
 
-inline void morton_order(const Aabb* boxes, uint32_t n, Buffer<unsigned long long>& codes, Buffer<uint32_t>& order) {
+// The codes into `codes` (n of them), sorted; `sort_scratch`: see sort_pairs.
+inline void morton_order(const Aabb* boxes, uint32_t n, unsigned long long* codes, Buffer<uint32_t>& order,
+                         void* sort_scratch = nullptr) {
   const Aabb centroids = thrust::transform_reduce(launch_and_read(), boxes, boxes + n, CentroidBox{}, Aabb::empty(),
                                                   JoinBoxes{});
-  codes.resize(n);
   order.resize(n);
-  for_each_index(n, ComputeMortonCodes{boxes, MortonFrame::of(centroids), ptr(codes), ptr(order)});
-  sort_pairs(codes, order, n, kMortonBits);
+  for_each_index(n, ComputeMortonCodes{boxes, MortonFrame::of(centroids), codes, ptr(order)});
+  sort_pairs(codes, ptr(order), n, kMortonBits, sort_scratch);
+}
+
+inline void morton_order(const Aabb* boxes, uint32_t n, Buffer<unsigned long long>& codes, Buffer<uint32_t>& order) {
+  codes.resize(n);
+  morton_order(boxes, n, ptr(codes), order);
 }
 
 }  // namespace KMBVH_BACKEND_NAMESPACE

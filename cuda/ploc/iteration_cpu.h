@@ -3,7 +3,8 @@
 // after a stalled iteration), then each thread counts the merges and survivors of its
 // share of the positions, and after a barrier merges and compacts its share at the offsets
 // of the shares before it (MergeAndCompact::at), and after another gathers the boxes of the
-// survivors it wrote into the columns (GatherClusterBoxes). No per-position counts, no scan
+// survivors it wrote into the columns (GatherClusterBoxes) and retires its new nodes' boxes
+// (RetireFreshBoxes). No per-position counts, no scan
 // over them, one fork and join an iteration; iterations of few clusters (the top of the
 // tree) run on one thread. The same tree as the GPU's steps.
 #pragma once
@@ -53,7 +54,7 @@ inline MergeCounts ploc_iteration_cpu(uint32_t count, uint32_t radius, bool pair
 #pragma omp barrier
     MergeCounts before;
     for (uint32_t u = 0; u < t; ++u) before = AddMergeCounts{}(before, shares[u + 1]);
-    const uint32_t first_kept = before.kept;
+    const MergeCounts first = before;
     for (uint32_t i = begin; i < end; ++i) {
       merge.at(i, before);
       before = AddMergeCounts{}(before, merge_counts(nearest, i));
@@ -62,8 +63,10 @@ inline MergeCounts ploc_iteration_cpu(uint32_t count, uint32_t radius, bool pair
     // Once every share has merged (the columns are read until then), each gathers the boxes
     // of the survivors it wrote.
 #pragma omp barrier
-    const GatherClusterBoxes gather{merge.next_clusters, merge.tree, box};
-    for (uint32_t k = first_kept; k < before.kept; ++k) gather(k);
+    const GatherClusterBoxes gather{merge.next_clusters, merge.boxes()};
+    for (uint32_t k = first.kept; k < before.kept; ++k) gather(k);
+    const RetireFreshBoxes retire{merge.boxes()};
+    for (uint32_t m = first.merges; m < before.merges; ++m) retire(m);
   }
   return shares[0];
 }

@@ -27,32 +27,34 @@ struct SetLeafBoxes {
 };
 
 // The nearest-neighbour search, sized by the radius (its window is a local array).
-inline void find_nearest(uint32_t count, uint32_t radius, BoxColumns box, Buffer<uint32_t>& nearest) {
+inline void find_nearest(uint32_t count, uint32_t radius, BoxColumns box, uint32_t* nearest) {
   if (radius <= 16)
-    for_each_index(count, FindNearest<16>{box, count, radius, ptr(nearest)});
+    for_each_index(count, FindNearest<16>{box, count, radius, nearest});
   else if (radius <= 64)
-    for_each_index(count, FindNearest<64>{box, count, radius, ptr(nearest)});
+    for_each_index(count, FindNearest<64>{box, count, radius, nearest});
   else
-    for_each_index(count, FindNearest<1024>{box, count, radius, ptr(nearest)});
+    for_each_index(count, FindNearest<1024>{box, count, radius, nearest});
 }
 
 // One iteration as the GPU runs it, a step a launch: the neighbours, the merges counted and
-// scanned, the survivors compacted, their boxes gathered into `box` for the next one.
+// scanned, the survivors compacted, their boxes gathered into `box` for the next one and the
+// new nodes' boxes retired into its tails (ClusterBoxes).
 // Returns the merges and the clusters left.
 inline MergeCounts ploc_iteration(uint32_t count, uint32_t radius, bool paired, BoxColumns box,
-                                  Buffer<uint32_t>& nearest, Buffer<MergeCounts>& counts,
-                                  Buffer<MergeCounts>& offsets, MergeAndCompact merge) {
+                                  uint32_t* nearest, Buffer<MergeCounts>& counts, Buffer<MergeCounts>& offsets,
+                                  MergeAndCompact merge) {
   if (paired)
-    for_each_index(count, PairNeighbours{count, ptr(nearest)});
+    for_each_index(count, PairNeighbours{count, nearest});
   else
     find_nearest(count, radius, box, nearest);
-  for_each_index(count, CountMerges{ptr(nearest), ptr(counts)});
+  for_each_index(count, CountMerges{nearest, ptr(counts)});
   thrust::exclusive_scan(launch(), counts.begin(), counts.begin() + count, offsets.begin(), MergeCounts{},
                          AddMergeCounts{});
   const MergeCounts total = AddMergeCounts{}(read(offsets, count - 1), read(counts, count - 1));
   merge.offsets = ptr(offsets);
   for_each_index(count, merge);
-  for_each_index(total.kept, GatherClusterBoxes{merge.next_clusters, merge.tree, box});
+  for_each_index(total.kept, GatherClusterBoxes{merge.next_clusters, merge.boxes()});
+  for_each_index(total.merges, RetireFreshBoxes{merge.boxes()});
   return total;
 }
 
@@ -61,24 +63,34 @@ inline Bvh build_ploc(const PrimitiveSet& prims, const BinaryBuildParams& params
   if (n < 2) return Bvh::single_leaf(prims.bounds(), n);
   PhaseClock clock(info);
   const InputBoxes boxes(prims.boxes);
-  Buffer<unsigned long long> codes;
+  // The clusters' boxes as columns (ClusterBoxes: the live clusters', then the inner nodes'),
+  // which first hold the Morton codes and the sort's scratch (20 of their 24 bytes a
+  // primitive), so that the clustering takes the memory the sort leaves.
+  Buffer<float> box_columns(6 * size_t(n));
   Buffer<uint32_t> order;
-  morton_order(boxes.data(), n, codes, order);
-  release(codes);
+  unsigned long long* const codes = reinterpret_cast<unsigned long long*>(ptr(box_columns));
+  morton_order(boxes.data(), n, codes, order, codes + n);
   clock.lap("morton");
 
   Buffer<uint32_t> left(n - 1), right(n - 1);
-  Buffer<Aabb> inner_box(n - 1);
   BinaryTreeView tree;
   tree.n = n;
   tree.left = ptr(left);
   tree.right = ptr(right);
-  tree.inner_box = ptr(inner_box);
   tree.prim_box = boxes.data();
   tree.order = ptr(order);
 
-  Buffer<uint32_t> clusters(n), next_clusters(n), nearest(n);
-  Buffer<float> box_columns(6 * size_t(n));
+  // The rest of the clustering's memory is one buffer of n boxes: this iteration's new
+  // nodes' boxes in its first half (an iteration merges at most half its clusters), the
+  // clusters' ids, the next iteration's and the nearest neighbours in its second (3n ids,
+  // 12n bytes, fit in n - n/2 boxes); once the clustering has ended, the tree's inner
+  // boxes, so that they take the memory the working arrays leave whatever the pool's
+  // ranges. 60 bytes a primitive at the peak with the tree's order and children, where
+  // separate arrays of inner boxes and of new ones held 72.
+  Buffer<Aabb> work(n);
+  Aabb* const fresh = ptr(work);
+  uint32_t* const ids = reinterpret_cast<uint32_t*>(ptr(work) + n / 2);
+  uint32_t *clusters = ids, *next_clusters = ids + n, *const nearest = ids + 2 * size_t(n);
   const BoxColumns cluster_box{ptr(box_columns), n};
   for_each_index(n, SetLeafBoxes{tree, cluster_box});
 #if KMBVH_BACKEND_CPU
@@ -88,17 +100,16 @@ inline Bvh build_ploc(const PrimitiveSet& prims, const BinaryBuildParams& params
   const bool fused = false;
 #endif
   Buffer<MergeCounts> counts(fused ? 0 : n), offsets(fused ? 0 : n);
-  thrust::sequence(launch(), clusters.begin(), clusters.end());  // leaf i: position i
+  thrust::sequence(launch(), clusters, clusters + n);  // leaf i: position i
   uint32_t count = n, next_inner = n;
   bool stalled = false;
   while (count > 1) {
     if (info) ++info->levels;
     if (stalled && info) ++info->forced_splits;
-    const MergeAndCompact merge{ptr(clusters), cluster_box, ptr(nearest), nullptr, next_inner, tree,
-                                ptr(next_clusters)};
+    const MergeAndCompact merge{clusters, cluster_box, nearest, nullptr, next_inner, tree, next_clusters, fresh};
     MergeCounts total;
 #if KMBVH_BACKEND_CPU
-    if (fused) total = ploc_iteration_cpu(count, params.ploc_radius, stalled, cluster_box, ptr(nearest), merge);
+    if (fused) total = ploc_iteration_cpu(count, params.ploc_radius, stalled, cluster_box, nearest, merge);
 #endif
     if (!fused)
       total = ploc_iteration(count, params.ploc_radius, stalled, cluster_box, nearest, counts, offsets, merge);
@@ -107,11 +118,13 @@ inline Bvh build_ploc(const PrimitiveSet& prims, const BinaryBuildParams& params
     stalled = !stalled && ploc_stalled(total.merges, count);
     count = total.kept;
   }
-  tree.root = read(clusters, 0);
-  release(clusters, next_clusters, nearest, counts, offsets, box_columns);
+  tree.root = 2 * n - 2;  // the last of the n - 1 merges
+  release(counts, offsets);
+  tree.inner_box = ptr(work);
+  for_each_index(n - 1, InnerBoxesFromColumns{cluster_box, tree.inner_box});
+  release(box_columns);
   clock.lap("clustering");
-  // Made now, in the memory the clustering's buffers leave (26 bytes a primitive off the
-  // build's peak); collapse() sets the leaves' part of the state.
+  // Made now, in the memory the columns leave.
   Buffer<uint32_t> parent;
   set_parents(tree, parent);
   CollapseState state(n);

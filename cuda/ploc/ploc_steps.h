@@ -161,20 +161,46 @@ struct CountMerges {
   KMBVH_HD void operator()(uint32_t i) const { out[i] = merge_counts(nearest, i); }
 };
 
-// The lower position of a mutual pair makes the new inner node (its children and
-// box) and keeps it; the higher one drops out. Survivors' ids are written to their
-// compacted positions; their boxes, which tree.box holds for every cluster, are gathered
-// into the columns afterwards (GatherClusterBoxes), so the columns the search reads are
-// not written while positions are still merging and one buffer of them does (24 bytes a
-// primitive off the build's peak).
+// Where each cluster's box is while PLOC clusters. The live clusters' are the columns'
+// positions 0 .. count - 1, which the search reads; a leaf's is its primitive's, in the
+// build's input; an inner node made in an earlier iteration is kept in the columns' tails,
+// which the merged clusters have left: inner node n + q at position n - 1 - q. (After the
+// iterations that leave `count` clusters, n - count merges have been made, and they are at
+// positions count .. n - 1, which no live cluster holds: each merge frees the room of its
+// box.) An inner node made in this iteration is in `fresh` until the iteration's survivors
+// have been gathered, then retired into its position (RetireFreshBoxes). So the clustering
+// holds no array of inner boxes beside the columns, 24 bytes a primitive off the build's
+// peak; they are copied out once it ends (InnerBoxesFromColumns).
+struct ClusterBoxes {
+  BoxColumns columns;
+  const Aabb* prim_box;
+  const uint32_t* order;
+  Aabb* fresh;           // this iteration's new inner nodes, first_fresh first
+  uint32_t n;            // primitives; the columns' stride
+  uint32_t first_fresh;  // node id of this iteration's first new inner node
+
+  KMBVH_HD static uint32_t retired_position(uint32_t n, uint32_t node) { return 2 * n - 1 - node; }
+  KMBVH_HD Aabb box(uint32_t node) const {
+    if (node < n) return prim_box[order[node]];
+    if (node >= first_fresh) return fresh[node - first_fresh];
+    return columns.get(retired_position(n, node));
+  }
+};
+
+// The lower position of a mutual pair makes the new inner node (its children, and its box
+// into `fresh`) and keeps it; the higher one drops out. Survivors' ids are written to their
+// compacted positions; their boxes are gathered into the columns afterwards
+// (GatherClusterBoxes), so the columns the search reads are not written while positions
+// are still merging and one buffer of them does (24 bytes a primitive off the build's peak).
 struct MergeAndCompact {
   const uint32_t* clusters;
   BoxColumns cluster_box;
   const uint32_t* nearest;
   const MergeCounts* offsets;  // exclusive scan of CountMerges (operator(); at() is given them)
   uint32_t first_inner;        // node id of this iteration's first new inner node
-  BinaryTreeView tree;
+  BinaryTreeView tree;         // its children are written; its inner boxes are not used
   uint32_t* next_clusters;
+  Aabb* fresh;                 // the new inner nodes' boxes (ClusterBoxes)
 
   KMBVH_HD void operator()(uint32_t i) const { at(i, offsets[i]); }
 
@@ -189,19 +215,44 @@ struct MergeAndCompact {
       node = first_inner + before.merges;
       tree.left[tree.inner(node)] = a;
       tree.right[tree.inner(node)] = b;
-      tree.set_box(node, join(cluster_box.get(i), cluster_box.get(j)));
+      fresh[before.merges] = join(cluster_box.get(i), cluster_box.get(j));
     }
     next_clusters[before.kept] = node;
+  }
+
+  ClusterBoxes boxes() const {
+    return {cluster_box, tree.prim_box, tree.order, fresh, tree.n, first_inner};
   }
 };
 
 // Position k of the next iteration: its cluster's box, into the columns the search reads.
+// It writes positions below the survivors' count and reads none of the live ones.
 struct GatherClusterBoxes {
   const uint32_t* clusters;
-  BinaryTreeView tree;
-  BoxColumns columns;
+  ClusterBoxes boxes;
 
-  KMBVH_HD void operator()(uint32_t k) const { columns.set(k, tree.box(clusters[k])); }
+  KMBVH_HD void operator()(uint32_t k) const { boxes.columns.set(k, boxes.box(clusters[k])); }
+};
+
+// This iteration's m-th new inner node's box, into its position in the columns' tails: a
+// position the survivors' count is at or below and the clusters' count was above, so the
+// gather neither reads nor writes it, and both may run at once.
+struct RetireFreshBoxes {
+  ClusterBoxes boxes;
+
+  KMBVH_HD void operator()(uint32_t m) const {
+    boxes.columns.set(ClusterBoxes::retired_position(boxes.n, boxes.first_fresh + m), boxes.fresh[m]);
+  }
+};
+
+// Inner node n + q's box, out of the columns once the clustering has ended.
+struct InnerBoxesFromColumns {
+  BoxColumns columns;
+  Aabb* inner_box;
+
+  KMBVH_HD void operator()(uint32_t q) const {
+    inner_box[q] = columns.get(ClusterBoxes::retired_position(columns.stride, columns.stride + q));
+  }
 };
 
 }  // namespace kmbvh
