@@ -41,12 +41,12 @@ inline void free_fresh(char* p) { thrust::device_free(thrust::device_pointer_cas
 //    address, if that is free and long enough), so a build asking for what the last one
 //    asked, in the same order, takes the same memory and allocates nothing;
 // 2. the start of the shortest free range that holds it (best fit), the rest left free; on
-//    the CPU, a request of a megabyte or more takes the shortest whose pages are in memory
+//    the CPU, a request of 64 KiB or more takes the shortest whose pages are in memory
 //    already where one holds it, since a segment's untouched tail would fault in fresh
 //    pages while memory the build has given back lies resident and free (k-means' tree
 //    nodes, moved after its level buffers are given back: 12 bytes a triangle of a
-//    context's peak on conference, which best fit put in the 4 MB tail of the subtree
-//    nodes' segment);
+//    context's peak on conference, 30 on sponza, which best fit put in the untouched tail
+//    of the subtree nodes' segment);
 // 3. a fresh segment, its length rounded up to a quarter of its power of two, so that a
 //    slightly longer buffer (a level of another size) still fits it next time.
 // Ranges given back join their free neighbours in the same segment. So buffers whose lives
@@ -110,7 +110,7 @@ class MemoryPool {
 
  private:
   static constexpr size_t kAlign = 256;  // as cudaMalloc aligns, and every range starts
-  static constexpr size_t kResidentFirstFrom = size_t(1) << 20;
+  static constexpr size_t kResidentFirstFrom = size_t(64) << 10;
 
   char* take_planned(size_t size) {
     if (taken_.size() >= plan_.size()) return nullptr;
