@@ -5,8 +5,8 @@
 // Node ids: 0 .. n-1 are the leaves, in the builder's primitive order (leaf i holds
 // primitive order[i]); n .. 2n-2 are the inner nodes. `left`, `right`, `inner_box` and the
 // collapse's results (collapse.h) are indexed by inner node id minus n; `parent` by node id
-// (the root's parent is kNoParent). A leaf's box is its primitive's, read from the build's input: not kept a
-// second time (24 bytes a primitive of the build's peak memory, issue #15).
+// (the root's parent is kNoParent). A leaf's box is its primitive's, read from the build's
+// input: not kept a second time (24 bytes a primitive of the build's peak memory, #15).
 #pragma once
 
 #include <cstdint>

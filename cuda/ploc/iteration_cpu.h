@@ -4,9 +4,9 @@
 // share of the positions, and after a barrier merges and compacts its share at the offsets
 // of the shares before it (MergeAndCompact::at), and after another gathers the boxes of the
 // survivors it wrote into the columns (GatherClusterBoxes) and retires its new nodes' boxes
-// (RetireFreshBoxes). No per-position counts, no scan
-// over them, one fork and join an iteration; iterations of few clusters (the top of the
-// tree) run on one thread. The same tree as the GPU's steps.
+// (RetireFreshBoxes). No per-position counts, no scan over them, one fork and join an
+// iteration; iterations of few clusters (the top of the tree) run on one thread. The same
+// tree as the GPU's steps.
 #pragma once
 
 #include <omp.h>
