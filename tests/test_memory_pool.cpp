@@ -110,7 +110,7 @@ TEST(MemoryPool, ASmallerBuildFitsWhatALargerOneLeft) {
   EXPECT_EQ(allocations_during([&] { build(100000); }), 0u);
 }
 
-// On the CPU a buffer of a megabyte or more goes into memory the build has touched before
+// On the CPU a buffer of 64 KiB or more goes into memory the build has touched before
 // memory it never has, where both hold it, even where the untouched range is the shorter.
 TEST(MemoryPool, ALargeBufferTakesTouchedMemoryBeforeUntouched) {
   MemoryPool pool;
